@@ -1,0 +1,131 @@
+"""Turn a :class:`SortedDAE` into CasADi functions: the semi-explicit DAE handed to IDAS
+(``x' = f(t, x, z, p)``, ``0 = g(t, x, z, p)``) and the observation of every variable.
+
+``p`` stacks the free parameters then the model inputs (held constant over a simulation
+interval). Parameters bound to expressions of other parameters are substituted away.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from ..core.flatmodel import FlatVariable
+from ..core.variables import time
+from ..errors import ParameterError
+from ..passes.sorting import SortedDAE
+
+
+@dataclass
+class CasadiDAE:
+    """Symbolic semi-explicit DAE and its observation map.
+
+    x, z, p: SX column vectors; ode/alg: SX expressions; observed: SX of every variable in
+    ``names`` order (derivatives and aliases included).
+    """
+
+    x: ca.SX
+    z: ca.SX
+    p: ca.SX
+    t: ca.SX
+    ode: ca.SX
+    alg: ca.SX
+    observed: ca.SX
+    names: list[str]
+    state_names: list[str]
+    algebraic_names: list[str]
+    parameters: list[FlatVariable]
+    inputs: list[FlatVariable]
+    x_start: np.ndarray
+    z_start: np.ndarray
+    fixed: list[tuple[int, float]]          # (index in names, value) of fixed start values
+    observed_index: dict[str, int]
+
+    @property
+    def p_default(self) -> np.ndarray:
+        vals = [float(p.decl.value) for p in self.parameters]
+        vals += [float(u.decl.start) for u in self.inputs]
+        return np.array(vals, dtype=float)
+
+    def p_vector(self, overrides: dict[str, float] | None = None) -> np.ndarray:
+        """Parameter-and-input vector with ``overrides`` applied (by dotted name)."""
+        vec = self.p_default
+        if overrides:
+            names = [p.name for p in self.parameters] + [u.name for u in self.inputs]
+            where = {n: k for k, n in enumerate(names)}
+            for key, value in overrides.items():
+                if key not in where:
+                    close = [n for n in names if n.split(".")[-1] == key.split(".")[-1]]
+                    hint = f"; did you mean {', '.join(close[:5])}?" if close else ""
+                    raise ParameterError(f"{key!r} is not a parameter or input of the "
+                                         f"model{hint}")
+                vec[where[key]] = _number(key, value)
+        return vec
+
+
+def _number(name: str, value: object) -> float:
+    try:
+        out = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise ParameterError(f"value for {name!r} is not a number: {value!r}") from None
+    if not np.isfinite(out):
+        raise ParameterError(f"value for {name!r} is not finite: {value!r}")
+    return out
+
+
+def build_dae(sorted_dae: SortedDAE) -> CasadiDAE:
+    """Assemble the CasADi DAE of a sorted model."""
+    model = sorted_dae.model
+    variables = model.variables
+    states = sorted_dae.states
+    state_set = set(states)
+    alg_vars = sorted_dae.algebraic
+    alg_set = set(alg_vars)
+
+    free_params = [p for p in model.parameters if not isinstance(p.decl.value, ca.SX)]
+    bound = [p for p in model.parameters if isinstance(p.decl.value, ca.SX)]
+
+    vsym = [variables[j].sx for j, _ in sorted_dae.assignments]
+    vdef = [d for _, d in sorted_dae.assignments]
+    assigned = {j: k for k, (j, _) in enumerate(sorted_dae.assignments)}
+    # what we need in terms of knowns: state derivatives, residuals, every variable
+    ode_raw = []
+    for j in states:
+        d = variables[j].der
+        ode_raw.append(variables[d].sx)
+    obs_raw = [v.sx for v in variables]
+    targets = ca.vertcat(*(ode_raw + list(sorted_dae.residuals) + obs_raw))
+    if vsym:
+        _, (targets,) = ca.substitute_inplace([ca.vertcat(*vsym)], [ca.vertcat(*vdef)],
+                                              [targets], False)
+    if bound:
+        bsym = ca.vertcat(*[p.sx for p in bound])
+        bdef = ca.vertcat(*[ca.SX(p.decl.value) for p in bound])
+        _, (targets,) = ca.substitute_inplace([bsym], [bdef], [targets], False)
+    n_x, n_r = len(states), len(sorted_dae.residuals)
+    ode = targets[:n_x]
+    alg = targets[n_x:n_x + n_r]
+    observed = targets[n_x + n_r:]
+    del assigned, state_set, alg_set
+
+    names = [v.name for v in variables]
+    observed_index = {n: k for k, n in enumerate(names)}
+    fixed = [(k, float(v.decl.start)) for k, v in enumerate(variables)
+             if v.der_of < 0 and getattr(v.decl, "fixed", False)]
+    p = ca.vertcat(*[q.sx for q in free_params], *[u.sx for u in model.inputs])
+    return CasadiDAE(
+        x=ca.vertcat(*[variables[j].sx for j in states]),
+        z=ca.vertcat(*[variables[j].sx for j in alg_vars]),
+        p=p if p.numel() else ca.SX(0, 1), t=time, ode=ode, alg=alg, observed=observed,
+        names=names, state_names=[variables[j].name for j in states],
+        algebraic_names=[variables[j].name for j in alg_vars],
+        parameters=free_params, inputs=list(model.inputs),
+        x_start=np.array([_start(variables[j]) for j in states], dtype=float),
+        z_start=np.array([_start(variables[j]) for j in alg_vars], dtype=float),
+        fixed=fixed, observed_index=observed_index)
+
+
+def _start(v: FlatVariable) -> float:
+    return float(getattr(v.decl, "start", 0.0))

@@ -1,0 +1,254 @@
+"""Components and connectors: acausal building blocks declared as plain Python classes.
+
+A component class declares parameters, variables, connectors and subcomponents in its body and
+writes its physics in ``equations()``, which yields ``lhs == rhs`` expressions and
+``connect(a, b)`` statements. Equations of base classes are inherited (as Modelica ``extends``):
+never call ``super().equations()``.
+
+    class Resistor(OnePort):
+        R = Parameter(1.0, unit="Ohm", description="Resistance")
+
+        def equations(self):
+            yield self.v == self.R * self.i
+
+Every instance owns its own symbols: inside ``equations()`` ``self.R`` is a CasADi SX scalar.
+Modifiers at construction override a parameter value (``Resistor(R=10)``) or set a variable's
+start value, fixed by default (``Capacitor(v=1.0)``; ``Capacitor(v=dict(start=1, fixed=False))``
+makes it a guess). A dotted modifier reaches into subcomponents (``Motor(**{"R.R": 2})``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import casadi as ca
+
+from ..errors import ConnectError, DeclarationError, DuplicateNameError
+from .variables import (
+    KIND_FLOW,
+    KIND_INPUT,
+    KIND_OUTPUT,
+    KIND_POTENTIAL,
+    Declaration,
+    Symbol,
+    lookup,
+)
+
+
+class Element:
+    """Common base of :class:`Component` and :class:`Connector`: declarations and children."""
+
+    _declarations: ClassVar[dict[str, Declaration]] = {}
+    _templates: ClassVar[dict[str, Element]] = {}
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        decls: dict[str, Declaration] = {}
+        templates: dict[str, Element] = {}
+        for base in reversed(cls.__mro__[1:]):
+            decls.update(getattr(base, "_declarations", {}))
+            templates.update(getattr(base, "_templates", {}))
+        for name, value in list(vars(cls).items()):
+            if isinstance(value, Declaration):
+                decls[name] = value
+            elif isinstance(value, Element):
+                templates[name] = value
+        cls._declarations = decls
+        cls._templates = templates
+
+    def __new__(cls, *args: Any, **kwargs: Any) -> Element:
+        self = super().__new__(cls)
+        object.__setattr__(self, "_init_call", (args, dict(kwargs)))
+        return self
+
+    def __init__(self, name: str | None = None, **modifiers: Any) -> None:
+        object.__setattr__(self, "_name", name)
+        object.__setattr__(self, "_symbols", {})
+        object.__setattr__(self, "_children", {})
+        object.__setattr__(self, "_equations", [])
+        nested = {k: v for k, v in modifiers.items() if "." in k}
+        local = {k: v for k, v in modifiers.items() if "." not in k}
+        for key, decl in type(self)._declarations.items():
+            if key in local:
+                decl = decl.with_start(local.pop(key))
+            sym = Symbol(key, decl, self)
+            self._symbols[key] = sym
+            object.__setattr__(self, key, sym.sx)
+        for key, template in type(self)._templates.items():
+            child = template.clone()
+            if key in local:
+                child.modify(**_as_modifiers(key, local.pop(key)))
+            self.add(key, child)
+        if local:
+            raise DeclarationError(
+                f"{type(self).__name__} has no parameter, variable or subcomponent "
+                f"{', '.join(map(repr, local))}; it has: {', '.join(self._symbols) or 'none'}")
+        if nested:
+            self.modify(**nested)
+
+    # -- structure -----------------------------------------------------------------------
+    def add(self, name: str, element: Element) -> Element:
+        """Add a subcomponent or connector under ``name`` and return it."""
+        if not isinstance(element, Element):
+            raise DeclarationError(f"{name!r} is not a component or connector: {element!r}")
+        if name in self._children or name in self._symbols:
+            raise DuplicateNameError(
+                f"{type(self).__name__} {self._name or ''}: a subcomponent or variable named "
+                f"{name!r} already exists")
+        if not name.isidentifier():
+            raise DeclarationError(f"{name!r} is not a valid component name")
+        object.__setattr__(element, "_name", name)
+        self._children[name] = element
+        object.__setattr__(self, name, element)
+        return element
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if isinstance(value, Element) and not name.startswith("_"):
+            self.add(name, value)
+        elif name in self.__dict__.get("_symbols", {}):
+            self.modify(**{name: value})
+        else:
+            object.__setattr__(self, name, value)
+
+    def modify(self, **modifiers: Any) -> None:
+        """Change parameter values / start values, by local or dotted name."""
+        for key, value in modifiers.items():
+            head, _, rest = key.partition(".")
+            if rest:
+                child = self._children.get(head)
+                if child is None:
+                    raise DeclarationError(f"{type(self).__name__} has no subcomponent {head!r}")
+                child.modify(**{rest: value})
+            elif head in self._symbols:
+                sym = self._symbols[head]
+                sym.decl = sym.decl.with_start(value)
+            elif head in self._children:
+                self._children[head].modify(**_as_modifiers(head, value))
+            else:
+                raise DeclarationError(
+                    f"{type(self).__name__} has no parameter or variable {head!r}")
+
+    def clone(self) -> Element:
+        """A fresh instance built with the same constructor arguments."""
+        args, kwargs = self._init_call
+        return type(self)(*args, **kwargs)
+
+    @property
+    def name(self) -> str | None:
+        return self._name
+
+    def symbols(self) -> dict[str, Symbol]:
+        return dict(self._symbols)
+
+    def children(self) -> dict[str, Element]:
+        return dict(self._children)
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self._name or ''})"
+
+
+def _as_modifiers(name: str, value: Any) -> dict[str, Any]:
+    if not isinstance(value, dict):
+        raise DeclarationError(f"modifier for subcomponent {name!r} must be a dict of values")
+    return value
+
+
+class Connector(Element):
+    """A port: potential and flow variables (or causal signals) and nothing else."""
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        for name, decl in cls._declarations.items():
+            if decl.kind not in (KIND_POTENTIAL, KIND_FLOW, KIND_INPUT, KIND_OUTPUT):
+                raise DeclarationError(
+                    f"connector {cls.__name__}.{name}: only Potential, Flow, Input and Output "
+                    "variables belong in a connector")
+
+    def signature(self) -> dict[str, str]:
+        return {name: sym.decl.kind for name, sym in self._symbols.items()}
+
+
+@dataclass(frozen=True)
+class Connection:
+    """``connect(a, b)``: two connectors, or two causal signals."""
+
+    a: Any
+    b: Any
+
+
+def connect(a: Any, b: Any) -> Connection:
+    """Join two connectors (potentials equal, flows sum to zero) or two signals."""
+    check_connectable(a, b)
+    return Connection(a, b)
+
+
+def _describe(x: Any) -> str:
+    if isinstance(x, Element):
+        return f"{type(x).__name__} {x.name or '?'}"
+    sym = lookup(x) if isinstance(x, ca.SX) and x.is_symbolic() else None
+    return f"{sym.decl.kind} variable {sym.name}" if sym else repr(x)
+
+
+def check_connectable(a: Any, b: Any) -> None:
+    """Raise :class:`ConnectError` unless ``a`` and ``b`` may be connected."""
+    if isinstance(a, Connector) and isinstance(b, Connector):
+        sa, sb = a.signature(), b.signature()
+        for name in sa.keys() & sb.keys():
+            if sa[name] != sb[name] and {sa[name], sb[name]} != {KIND_INPUT, KIND_OUTPUT}:
+                raise ConnectError(
+                    f"cannot connect {_describe(a)} to {_describe(b)}: {name} is a {sa[name]} "
+                    f"variable in one and a {sb[name]} variable in the other")
+        if sa.keys() != sb.keys():
+            raise ConnectError(
+                f"cannot connect {_describe(a)} ({', '.join(sa)}) to {_describe(b)} "
+                f"({', '.join(sb)}): incompatible connector types")
+        for name in sa:
+            ua, ub = a._symbols[name].decl.unit, b._symbols[name].decl.unit
+            if ua and ub and ua != ub:
+                raise ConnectError(
+                    f"cannot connect {_describe(a)} to {_describe(b)}: {name} has unit "
+                    f"{ua!r} in one and {ub!r} in the other")
+        return
+    syms = []
+    for x in (a, b):
+        sym = lookup(x) if isinstance(x, ca.SX) and x.numel() == 1 and x.is_symbolic() else None
+        if sym is None:
+            raise ConnectError(
+                f"cannot connect {_describe(a)} to {_describe(b)}: connect() joins two "
+                "connectors or two signal variables (Input/Output)")
+        syms.append(sym)
+    kinds = {s.decl.kind for s in syms}
+    if not kinds <= {KIND_INPUT, KIND_OUTPUT}:
+        raise ConnectError(
+            f"cannot connect {_describe(a)} to {_describe(b)}: only connectors or causal "
+            "signals (Input/Output) can be connected; connect the connectors that hold them")
+    if kinds == {KIND_OUTPUT}:
+        raise ConnectError(f"cannot connect two outputs: {syms[0].name} and {syms[1].name}")
+
+
+class Component(Element):
+    """A model: declarations, subcomponents, and equations (see module docstring)."""
+
+    def equations(self) -> Iterable[Any]:
+        """Yield this class's own equations ``lhs == rhs`` and ``connect(a, b)`` statements."""
+        return ()
+
+    def connect(self, a: Any, b: Any) -> None:
+        """Imperative form of ``connect`` for models assembled in code."""
+        self._equations.append(connect(a, b))
+
+    def equation(self, *eqs: Any) -> None:
+        """Imperative form: add equations ``lhs == rhs`` to this component."""
+        self._equations.extend(eqs)
+
+    def all_equations(self) -> Iterator[Any]:
+        """Equations of every class in the hierarchy (base classes first), then added ones."""
+        for cls in reversed(type(self).__mro__):
+            own = vars(cls).get("equations")
+            if own is not None:
+                result = own(self)
+                if result is not None:
+                    yield from result
+        yield from self._equations

@@ -1,0 +1,100 @@
+"""The flat model: every scalar of a component tree under its dotted name, and its equations."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import casadi as ca
+
+from .variables import Declaration, StateSelect
+
+
+@dataclass
+class FlatVariable:
+    """One scalar of the flat model.
+
+    name: dotted name (``motor.R.i``; derivatives are ``der(motor.L.i)``).
+    decl: declaration metadata (unit, start, fixed, nominal, state_select...).
+    component: dotted path of the component that declared it ("" for the top level).
+    der_of / der: indices (in :attr:`FlatModel.variables`) linking a variable and its time
+    derivative; -1 when absent.
+    """
+
+    name: str
+    sx: ca.SX
+    decl: Declaration
+    component: str
+    der_of: int = -1
+    der: int = -1
+
+    @property
+    def origin(self) -> str:
+        return f"{self.name} (declared in {self.component or 'the top-level model'})"
+
+    @property
+    def state_select(self) -> StateSelect:
+        return getattr(self.decl, "state_select", StateSelect.DEFAULT)
+
+
+@dataclass
+class FlatEquation:
+    """A residual equation ``residual == 0`` and where it came from.
+
+    origin: the component path and class that wrote it, or the connection set.
+    alias: for equations of the form ``a = s*b`` the variable indices and sign ``(a, b, s)``.
+    """
+
+    residual: ca.SX
+    origin: str
+    alias: tuple[int, int, float] | None = None
+
+    def describe(self, names: dict[int, str] | None = None, width: int = 100) -> str:
+        """``0 = residual   [origin]`` with dotted names when ``names`` (hash -> name) given."""
+        res = self.residual
+        if names:
+            syms = [s for s in ca.symvar(res) if s.element_hash() in names]
+            res = ca.substitute(res, ca.vertcat(*syms),
+                                ca.vertcat(*[ca.SX.sym(names[s.element_hash()]) for s in syms]))
+        text = str(res)
+        if len(text) > width:
+            text = text[: width - 3] + "..."
+        return f"0 = {text}   [{self.origin}]"
+
+
+@dataclass
+class FlatModel:
+    """Variables, parameters, inputs and equations of a flattened model.
+
+    ``variables`` are the unknowns, derivative variables included (linked by ``der``/
+    ``der_of``); ``aliases`` maps eliminated names to ``(kept name, sign)``.
+    """
+
+    name: str
+    variables: list[FlatVariable]
+    parameters: list[FlatVariable]
+    inputs: list[FlatVariable]
+    equations: list[FlatEquation]
+    aliases: dict[str, tuple[str, float]] = field(default_factory=dict)
+
+    def index(self) -> dict[str, int]:
+        """Name -> index in :attr:`variables`."""
+        return {v.name: i for i, v in enumerate(self.variables)}
+
+    @property
+    def unknowns(self) -> list[int]:
+        """Indices of the unknowns that are not derivatives of another variable."""
+        return [i for i, v in enumerate(self.variables) if v.der_of < 0]
+
+    def names(self) -> dict[int, str]:
+        """SX node hash -> dotted name, for printing equations."""
+        out = {v.sx.element_hash(): v.name for v in self.variables}
+        out.update((p.sx.element_hash(), p.name) for p in self.parameters)
+        out.update((u.sx.element_hash(), u.name) for u in self.inputs)
+        return out
+
+    def describe(self, k: int) -> str:
+        """Equation ``k`` printed with dotted names and its origin."""
+        return self.equations[k].describe(self.names())
+
+    def parameter_values(self) -> dict[str, object]:
+        return {p.name: p.decl.value for p in self.parameters}

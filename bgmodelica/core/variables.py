@@ -1,0 +1,177 @@
+"""Declarations of parameters and variables, and their per-instance symbols.
+
+A declaration (``Parameter``, ``Variable``, ``Potential``, ``Flow``, ``Input``, ``Output``) is
+written once in a component class body. Each component instance turns every declaration into a
+:class:`Symbol`: a CasADi SX scalar plus the declaration's metadata. Inside ``equations()``,
+``self.R`` *is* the SX scalar, so physics reads as plain algebra.
+"""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass, replace
+from enum import IntEnum
+from typing import Any
+
+import casadi as ca
+
+from ..errors import DeclarationError
+
+
+class StateSelect(IntEnum):
+    """State-selection priority, as Modelica's ``stateSelect``."""
+
+    NEVER = -2
+    AVOID = -1
+    DEFAULT = 0
+    PREFER = 1
+    ALWAYS = 2
+
+
+KIND_PARAMETER = "parameter"
+KIND_VARIABLE = "variable"
+KIND_POTENTIAL = "potential"
+KIND_FLOW = "flow"
+KIND_INPUT = "input"
+KIND_OUTPUT = "output"
+
+
+@dataclass(frozen=True, kw_only=True)
+class Declaration:
+    """Metadata shared by parameters and variables.
+
+    unit: unit string (SI, Modelica spelling: "V", "A", "rad/s", "N.m", "kg.m2").
+    description: one line shown in reports, CSV headers of FMUs, plots.
+    """
+
+    unit: str = ""
+    description: str = ""
+    kind = KIND_VARIABLE
+
+    def with_start(self, value: Any) -> Declaration:
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class Parameter(Declaration):
+    """A constant of the model, tunable between simulations without recompiling.
+
+    value: default value, a number or an expression of other parameters.
+    """
+
+    value: Any = 0.0
+    min: float | None = None
+    max: float | None = None
+    kind = KIND_PARAMETER
+
+    def with_start(self, value: Any) -> Parameter:
+        return replace(self, value=value)
+
+
+@dataclass(frozen=True)
+class Variable(Declaration):
+    """A time-varying unknown.
+
+    start: initial value (a hard condition if ``fixed``, otherwise a guess).
+    fixed: whether ``start`` is an initial condition.
+    nominal: typical magnitude, used for scaling and error control.
+    state_select: priority for being chosen as a state (see :class:`StateSelect`).
+    """
+
+    start: float = 0.0
+    fixed: bool = False
+    nominal: float = 1.0
+    min: float | None = None
+    max: float | None = None
+    state_select: StateSelect = StateSelect.DEFAULT
+    kind = KIND_VARIABLE
+
+    def with_start(self, value: Any) -> Variable:
+        if isinstance(value, dict):
+            try:
+                return replace(self, **value)
+            except TypeError as err:
+                raise DeclarationError(f"bad modifier {value!r}: {err}") from None
+        return replace(self, start=value, fixed=True)
+
+
+@dataclass(frozen=True)
+class Potential(Variable):
+    """Connector variable made equal across a connection (voltage, angle, effort)."""
+
+    kind = KIND_POTENTIAL
+
+
+@dataclass(frozen=True)
+class Flow(Variable):
+    """Connector variable summed to zero across a connection (current, torque, flow).
+
+    Positive when it flows *into* the component that owns the connector.
+    """
+
+    kind = KIND_FLOW
+
+
+@dataclass(frozen=True)
+class Input(Variable):
+    """Causal signal input; set by a connected output, or an input of the whole model."""
+
+    kind = KIND_INPUT
+
+
+@dataclass(frozen=True)
+class Output(Variable):
+    """Causal signal output; defined by an equation of its component."""
+
+    kind = KIND_OUTPUT
+
+
+class Symbol:
+    """One declared scalar of one component instance.
+
+    Attributes: ``name`` (local), ``decl`` (its :class:`Declaration`), ``sx`` (the SX scalar),
+    ``owner`` (the component or connector instance), and, once ``der`` has been taken, ``der``
+    (the Symbol of its time derivative).
+    """
+
+    __slots__ = ("name", "decl", "sx", "owner", "der", "der_of", "__weakref__")
+
+    def __init__(self, name: str, decl: Declaration, owner: Any, der_of: Symbol | None = None):
+        self.name = name
+        self.decl = decl
+        self.sx = ca.SX.sym(name)
+        self.owner = owner
+        self.der: Symbol | None = None
+        self.der_of = der_of
+        _REGISTRY[self.sx.element_hash()] = self
+
+    def derivative(self) -> Symbol:
+        """The symbol of this variable's time derivative (created once)."""
+        if self.decl.kind == KIND_PARAMETER:
+            raise DeclarationError(f"der() of parameter {self.name!r}: parameters are constant")
+        if self.der is None:
+            self.der = Symbol(f"der({self.name})", Variable(unit=derivative_unit(self.decl.unit)),
+                              self.owner, der_of=self)
+        return self.der
+
+    def __repr__(self) -> str:
+        return f"Symbol({self.name!r}, {type(self.decl).__name__})"
+
+
+def derivative_unit(unit: str) -> str:
+    """Unit of the time derivative of a quantity in ``unit``."""
+    if not unit or unit == "1":
+        return "1/s"
+    return f"{unit}/s"
+
+
+#: SX node hash -> Symbol, so ``der(x)`` can find the declaration behind an SX scalar.
+_REGISTRY: weakref.WeakValueDictionary[int, Symbol] = weakref.WeakValueDictionary()
+
+#: The model time, shared by all models.
+time = ca.SX.sym("time")
+
+
+def lookup(sx: ca.SX) -> Symbol | None:
+    """The Symbol behind an SX scalar symbol, or None (time or a foreign symbol)."""
+    return _REGISTRY.get(sx.element_hash())

@@ -1,0 +1,104 @@
+"""Signed alias elimination: remove ``a = b``, ``a = -b``, ``a + b = 0`` and their variables."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import casadi as ca
+
+from ..core.flatmodel import FlatEquation, FlatModel, FlatVariable
+from ..core.variables import Variable, derivative_unit
+from ..errors import InitializationError
+from ..structure.alias import alias_classes
+
+
+def eliminate_aliases(model: FlatModel) -> FlatModel:
+    """Return a model without alias equations; ``aliases`` records every removed variable."""
+    variables = model.variables
+    links, link_eqs = [], []
+    for k, eq in enumerate(model.equations):
+        if eq.alias is not None:
+            links.append(eq.alias)
+            link_eqs.append(k)
+    if not links:
+        return model
+
+    def rank(i: int) -> tuple:
+        v = variables[i]
+        return (v.der >= 0, v.state_select, bool(getattr(v.decl, "fixed", False)),
+                -v.name.count("."), -len(v.name))
+
+    classes = alias_classes(len(variables), links, lambda a, b: rank(a) > rank(b))
+    used = set(link_eqs) - {link_eqs[k] for k in classes.redundant}
+
+    new_vars = list(variables)
+    _merge_metadata(new_vars, classes.rep, classes.sign)
+    old, new = [], []
+    eliminated: set[int] = set()
+    aliases = dict(model.aliases)
+    for i, v in enumerate(variables):
+        r = classes.rep[i]
+        if r == i:
+            continue
+        s = classes.sign[i]
+        old.append(v.sx)
+        new.append(s * variables[r].sx)
+        eliminated.add(i)
+        aliases[v.name] = (variables[r].name, s)
+        below_old, below_new = i, r
+        while variables[below_old].der >= 0:       # der(v) = s * der(r), der(der(v)) = ...
+            d_old = variables[below_old].der
+            d_new = _ensure_derivative(new_vars, below_new)
+            old.append(variables[d_old].sx)
+            new.append(s * new_vars[d_new].sx)
+            aliases[variables[d_old].name] = (new_vars[d_new].name, s)
+            eliminated.add(d_old)
+            below_old, below_new = d_old, d_new
+
+    kept = [eq for k, eq in enumerate(model.equations) if k not in used]
+    residuals = ca.substitute([eq.residual for eq in kept], old, new) if kept else []
+    equations = [FlatEquation(res, eq.origin) for res, eq in zip(residuals, kept, strict=True)]
+    keep_idx = [i for i in range(len(new_vars)) if i not in eliminated]
+    remap = {old_i: new_i for new_i, old_i in enumerate(keep_idx)}
+    final = []
+    for i in keep_idx:
+        v = new_vars[i]
+        final.append(replace(v, der=remap.get(v.der, -1), der_of=remap.get(v.der_of, -1)))
+    return FlatModel(model.name, final, model.parameters, model.inputs, equations, aliases)
+
+
+def _ensure_derivative(variables: list[FlatVariable], i: int) -> int:
+    """Index of der(variables[i]), appending a new derivative variable if needed."""
+    v = variables[i]
+    if v.der >= 0:
+        return v.der
+    d = FlatVariable(f"der({v.name})", ca.SX.sym(f"der({v.name})"),
+                     Variable(unit=derivative_unit(v.decl.unit)), v.component, der_of=i)
+    variables.append(d)
+    variables[i] = replace(v, der=len(variables) - 1)
+    return len(variables) - 1
+
+
+def _merge_metadata(variables: list[FlatVariable], rep: list[int], sign: list[float]) -> None:
+    """Carry fixed start values and the strongest state priority to each representative."""
+    for i, v in enumerate(list(variables)):
+        r = rep[i]
+        if r == i:
+            continue
+        rv = variables[r]
+        dv, dr = v.decl, rv.decl
+        updates = {}
+        if getattr(dv, "state_select", 0) > getattr(dr, "state_select", 0):
+            updates["state_select"] = dv.state_select
+        if getattr(dv, "fixed", False):
+            start = sign[i] * dv.start
+            if getattr(dr, "fixed", False) and abs(dr.start - start) > 1e-12 * (1 + abs(start)):
+                raise InitializationError(
+                    f"conflicting fixed start values for aliases {v.name} = {sign[i]:+g} * "
+                    f"{rv.name}: {v.name}.start = {dv.start} ({v.component or 'top'}) but "
+                    f"{rv.name}.start = {dr.start} ({rv.component or 'top'})")
+            updates.update(start=start, fixed=True)
+        elif not getattr(dr, "fixed", False) and dr.start == 0 and dv.start != 0:
+            updates["start"] = sign[i] * dv.start
+        if updates and hasattr(dr, "fixed"):
+            variables[r] = replace(rv, decl=replace(dr, **updates))

@@ -1,0 +1,126 @@
+"""Index reduction: Pantelides on the integer graph, symbolic differentiation of the equations
+it selects, then dummy derivatives (Mattsson-Söderlind) honouring ``state_select``.
+
+The result is an index-1 system: the augmented flat model plus the chosen states (integrated
+variables) and dummy derivatives (derivatives demoted to algebraic unknowns).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+import casadi as ca
+
+from ..core.flatmodel import FlatEquation, FlatModel, FlatVariable
+from ..core.variables import Variable, derivative_unit, time
+from ..errors import EquationError, UnbalancedModelError
+from ..structure import EquationGraph, dummy_derivatives, pantelides
+from ..structure.errors import StructuralError, StructurallySingular
+from .symbolic import incidence, time_derivative
+
+Selector = Callable[[int, list[int], list[int], list[int]], list[int]]
+
+
+@dataclass
+class ReducedModel:
+    """An index-1 view of a flat model.
+
+    model: the flat model augmented with differentiated equations and derivative variables.
+    states: indices of the integrated variables; ``dummies``: derivatives made algebraic.
+    differentiated: ``(new equation, equation it differentiates)`` in creation order.
+    index: structural differential index of the original model.
+    has_choice: whether the state selection could have to change during a simulation.
+    """
+
+    model: FlatModel
+    graph: EquationGraph
+    states: list[int]
+    dummies: list[int]
+    differentiated: list[tuple[int, int]]
+    index: int
+    has_choice: bool
+    levels: list
+
+
+def reduce_index(model: FlatModel, select: Selector | None = None) -> ReducedModel:
+    """Return the index-1 :class:`ReducedModel` of a balanced flat model."""
+    syms = [v.sx for v in model.variables]
+    eq_vars = incidence([e.residual for e in model.equations], syms)
+    graph = EquationGraph(eq_vars, len(syms), [v.der for v in model.variables])
+    try:
+        pant = pantelides(graph)
+    except StructurallySingular as err:
+        raise _singular(model, err) from None
+    except StructuralError as err:
+        raise UnbalancedModelError(f"index reduction of {model.name} failed: {err}") from None
+
+    variables = list(model.variables)
+    equations = list(model.equations)
+    for new, of in pant.new_variables:
+        assert new == len(variables), "derivative variables must be appended in order"
+        v = variables[of]
+        variables[of] = replace(v, der=new)
+        name = f"der({v.name})"
+        variables.append(FlatVariable(name, ca.SX.sym(name), Variable(
+            unit=derivative_unit(v.decl.unit), nominal=getattr(v.decl, "nominal", 1.0)),
+            v.component, der_of=of))
+    rows = list(eq_vars)
+    for new, of in pant.new_equations:
+        assert new == len(equations), "differentiated equations must be appended in order"
+        src = equations[of]
+        vs = rows[of]
+        missing = [variables[j].name for j in vs if variables[j].der < 0]
+        if missing:
+            raise EquationError(f"index reduction must differentiate {src.origin} but "
+                                f"{', '.join(missing)} has no derivative")
+        _check_inputs(model, src)
+        res = time_derivative(src.residual, [variables[j].sx for j in vs],
+                              [variables[variables[j].der].sx for j in vs], time)
+        equations.append(FlatEquation(res, f"d/dt of {src.origin}"))
+        rows.append(incidence([res], [variables[j].sx for j in range(len(variables))])[0]
+                    if res.numel() else [])
+    aug = FlatModel(model.name, variables, model.parameters, model.inputs, equations,
+                    model.aliases)
+    eq_derivative = [-1] * len(equations)
+    for new, of in pant.new_equations:
+        eq_derivative[of] = new
+    exact = EquationGraph(rows, len(variables), [v.der for v in variables], eq_derivative)
+    base = exact.base_vars()
+    priority = [int(variables[base[j]].state_select) for j in range(len(variables))]
+    try:
+        dd = dummy_derivatives(exact, priority, select=select)
+    except StructuralError as err:
+        raise UnbalancedModelError(f"state selection for {model.name} failed: {err}") from None
+    return ReducedModel(aug, exact, list(dd.states), list(dd.dummies),
+                        list(pant.new_equations), _index(pant), dd.has_choice, dd.levels)
+
+
+def _index(pant) -> int:
+    return int(getattr(pant, "index", getattr(pant, "max_equation_differentiations", 0)))
+
+
+def _check_inputs(model: FlatModel, src: FlatEquation) -> None:
+    """Differentiating an equation that reads an input would need the input's derivative."""
+    for u in model.inputs:
+        if ca.depends_on(src.residual, u.sx):
+            raise EquationError(
+                f"index reduction must differentiate an equation of {src.origin} that reads "
+                f"the model input {u.name}; its time derivative is unknown. Drive it through a "
+                "smooth source (e.g. a block computing it) or reformulate the coupling")
+
+
+def _singular(model: FlatModel, err: StructurallySingular) -> UnbalancedModelError:
+    names = model.names()
+    over = [model.equations[i].describe(names) for i in err.overdetermined_eqs
+            if i < len(model.equations)]
+    under = [model.variables[j].origin for j in err.underdetermined_vars
+             if j < len(model.variables)]
+    lines = [f"model {model.name} is structurally singular"]
+    if under:
+        lines.append("under-determined variables:")
+        lines += [f"  {u}" for u in under[:12]]
+    if over:
+        lines.append("over-determined equations:")
+        lines += [f"  {o}" for o in over[:12]]
+    return UnbalancedModelError("\n".join(lines), missing=under, surplus=over)

@@ -1,0 +1,134 @@
+"""BLT sorting and tearing of an index-1 system into explicit assignments and residuals.
+
+Given the states as known, every other variable (state derivatives, algebraic variables, dummy
+derivatives) is an unknown. The equations are matched to unknowns, sorted into strongly
+connected blocks (Tarjan), and each block is made explicit where possible:
+
+- a scalar equation linear in its unknown becomes an assignment;
+- a loop is torn; if the torn residuals are linear in the tearing variables they are solved
+  symbolically, so the loop disappears from the simulated system;
+- otherwise the tearing variables stay algebraic unknowns (IDAS ``z``) with their residuals.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import casadi as ca
+
+from ..errors import UnbalancedModelError
+from ..structure import block_lower_triangular, maximum_matching, tear
+from .index_reduction import ReducedModel
+from .symbolic import solve_linear_block, solve_linear_scalar
+
+
+@dataclass
+class BlockInfo:
+    """One BLT block, for reports: its size, tearing variables and how it was solved."""
+
+    size: int
+    kind: str          # "explicit", "linear", "nonlinear"
+    variables: list[str]
+    tear: list[str] = field(default_factory=list)
+
+
+@dataclass
+class SortedDAE:
+    """The causalized index-1 system.
+
+    assignments: ``(variable index, expression)`` in evaluation order; an expression uses
+    knowns (states, algebraic ``z``, parameters, inputs, time) and earlier assignments only.
+    algebraic: variable indices kept as algebraic unknowns; ``residuals`` determine them.
+    """
+
+    reduced: ReducedModel
+    assignments: list[tuple[int, ca.SX]]
+    algebraic: list[int]
+    residuals: list[ca.SX]
+    blocks: list[BlockInfo]
+
+    @property
+    def model(self):
+        return self.reduced.model
+
+    @property
+    def states(self) -> list[int]:
+        return self.reduced.states
+
+
+def sort_equations(reduced: ReducedModel) -> SortedDAE:
+    """BLT-sort and tear ``reduced``; raise if it is structurally singular."""
+    model = reduced.model
+    variables = model.variables
+    states = set(reduced.states)
+    unknowns = [j for j in range(len(variables)) if j not in states]
+    column = {j: k for k, j in enumerate(unknowns)}
+    eq_cols = [[column[j] for j in row if j in column] for row in reduced.graph.eq_vars]
+    if len(eq_cols) != len(unknowns):
+        raise UnbalancedModelError(
+            f"after index reduction {model.name} has {len(eq_cols)} equations for "
+            f"{len(unknowns)} unknowns")
+    matching = maximum_matching(eq_cols, len(unknowns))
+    if matching.size != len(unknowns):
+        names = model.names()
+        bad_vars = [variables[unknowns[c]].origin for c in range(len(unknowns))
+                    if matching.var_to_eq[c] < 0]
+        bad_eqs = [model.equations[i].describe(names) for i in range(len(eq_cols))
+                   if matching.eq_to_var[i] < 0]
+        raise UnbalancedModelError(
+            f"{model.name} is structurally singular once the states are known:\n"
+            + "\n".join(f"  undetermined: {v}" for v in bad_vars[:12])
+            + "\n" + "\n".join(f"  surplus: {e}" for e in bad_eqs[:12]),
+            missing=bad_vars, surplus=bad_eqs)
+
+    res = [e.residual for e in model.equations]
+    sym = [variables[j].sx for j in unknowns]
+    out = SortedDAE(reduced, [], [], [], [])
+    for block in block_lower_triangular(eq_cols, len(unknowns), matching):
+        eqs, cols = list(block.eqs), list(block.vars)
+        names = [variables[unknowns[c]].name for c in cols]
+        if len(eqs) == 1:
+            expr = solve_linear_scalar(res[eqs[0]], sym[cols[0]])
+            if expr is not None:
+                out.assignments.append((unknowns[cols[0]], expr))
+                out.blocks.append(BlockInfo(1, "explicit", names))
+                continue
+            out.algebraic.append(unknowns[cols[0]])
+            out.residuals.append(res[eqs[0]])
+            out.blocks.append(BlockInfo(1, "nonlinear", names, names))
+            continue
+        _loop(out, eqs, cols, eq_cols, res, sym, unknowns, names, variables)
+    return out
+
+
+def _loop(out: SortedDAE, eqs, cols, eq_cols, res, sym, unknowns, names, variables) -> None:
+    cache: dict[tuple[int, int], ca.SX | None] = {}
+
+    def solved(e: int, c: int) -> ca.SX | None:
+        if (e, c) not in cache:
+            cache[(e, c)] = solve_linear_scalar(res[e], sym[c])
+        return cache[(e, c)]
+
+    torn = tear(eqs, cols, eq_cols, lambda e, c: solved(e, c) is not None)
+    tear_cols = list(torn.tear_vars)
+    tear_names = [variables[unknowns[c]].name for c in tear_cols]
+    causal = [(c, solved(e, c)) for e, c in torn.causal]
+    # residuals in terms of the tearing variables only
+    inner_sym = [sym[c] for c, _ in causal]
+    inner_def = [d for _, d in causal]
+    resid = [res[e] for e in torn.residual_eqs]
+    if inner_sym:
+        _, (resid_sub,) = ca.substitute_inplace([ca.vertcat(*inner_sym)],
+                                                [ca.vertcat(*inner_def)],
+                                                [ca.vertcat(*resid)], False)
+        resid = [resid_sub[k] for k in range(resid_sub.numel())]
+    solution = solve_linear_block(resid, [sym[c] for c in tear_cols]) if tear_cols else None
+    if solution is not None or not tear_cols:
+        for k, c in enumerate(tear_cols):
+            out.assignments.append((unknowns[c], solution[k]))
+        out.blocks.append(BlockInfo(len(eqs), "linear", names, tear_names))
+    else:
+        out.algebraic.extend(unknowns[c] for c in tear_cols)
+        out.residuals.extend(res[e] for e in torn.residual_eqs)
+        out.blocks.append(BlockInfo(len(eqs), "nonlinear", names, tear_names))
+    out.assignments.extend((unknowns[c], d) for c, d in causal)

@@ -1,0 +1,60 @@
+"""The symbolic helpers the passes hand to the structural algorithms (CasADi SX underneath)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import casadi as ca
+
+
+def incidence(residuals: Sequence[ca.SX], symbols: Sequence[ca.SX]) -> list[list[int]]:
+    """For each residual, the indices of the ``symbols`` it depends on (one sparse pass)."""
+    if not residuals:
+        return []
+    rows: list[list[int]] = [[] for _ in residuals]
+    if not symbols:
+        return rows
+    sp = ca.jacobian_sparsity(ca.vertcat(*residuals), ca.vertcat(*symbols))
+    r, c = sp.get_triplet()
+    for i, j in zip(r, c, strict=True):
+        rows[i].append(j)
+    return rows
+
+
+def time_derivative(residual: ca.SX, syms: Sequence[ca.SX], rates: Sequence[ca.SX],
+                    time: ca.SX) -> ca.SX:
+    """d/dt of ``residual`` given the time derivatives ``rates`` of ``syms``."""
+    out = ca.jacobian(residual, time) if ca.depends_on(residual, time) else ca.SX(0)
+    if syms:
+        out = out + ca.jtimes(residual, ca.vertcat(*syms), ca.vertcat(*rates))
+    return ca.simplify(out) if out.numel() == 1 else out
+
+
+def solve_linear_scalar(residual: ca.SX, var: ca.SX) -> ca.SX | None:
+    """``var`` from ``residual(var) = 0`` when the residual is linear in ``var``, else None."""
+    if residual.is_op(ca.OP_SUB):
+        lhs, rhs = residual.dep(0), residual.dep(1)
+        if ca.is_equal(lhs, var) and not ca.depends_on(rhs, var):
+            return rhs
+        if ca.is_equal(rhs, var) and not ca.depends_on(lhs, var):
+            return lhs
+    a = ca.jacobian(residual, var)
+    if ca.depends_on(a, var):
+        return None
+    if a.is_zero():
+        return None
+    b = ca.substitute(residual, var, ca.SX(0))
+    return -b / a
+
+
+def solve_linear_block(residuals: Sequence[ca.SX], vars_: Sequence[ca.SX],
+                       max_size: int = 40) -> ca.SX | None:
+    """Solution of a square block linear in ``vars_`` (symbolic), or None if nonlinear/large."""
+    if len(vars_) > max_size:
+        return None
+    r, v = ca.vertcat(*residuals), ca.vertcat(*vars_)
+    a = ca.jacobian(r, v)
+    if ca.depends_on(a, v):
+        return None
+    b = ca.substitute(r, v, ca.DM.zeros(v.numel()))
+    return ca.solve(a, -b)

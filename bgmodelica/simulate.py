@@ -1,0 +1,183 @@
+"""``simulate``: compile (if needed), initialize, integrate with SUNDIALS IDAS, observe."""
+
+from __future__ import annotations
+
+import time as _time
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from .backends.casadi_dae import CasadiDAE
+from .backends.casadi_init import initialize
+from .compiler import CompiledModel, compile
+from .core.component import Component
+from .errors import ParameterError, SimulationError
+from .result import Result
+
+_HINTS = {
+    "IDA_CONV_FAIL": "the Newton iteration failed repeatedly: the model may be singular at "
+                     "this point (check the algebraic loops) or very stiff",
+    "IDA_ERR_FAIL": "error test failed repeatedly: a discontinuity or a finite-time blow-up",
+    "IDA_TOO_MUCH_WORK": "too many internal steps: raise max_steps or check for a blow-up",
+    "IDA_LSETUP_FAIL": "the linear solver setup failed: singular iteration matrix",
+    "IDA_LSOLVE_FAIL": "the linear solve failed: singular iteration matrix",
+    "IDA_RES_FAIL": "the residual could not be evaluated (NaN / Inf in the model)",
+    "IDA_REP_RES_ERR": "the residual returned NaN / Inf repeatedly",
+    "CV_CONV_FAILURE": "the Newton iteration failed repeatedly",
+    "CV_ERR_FAILURE": "error test failed repeatedly",
+    "CV_TOO_MUCH_WORK": "too many internal steps",
+}
+
+
+def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
+             interval: float | None = None, params: dict[str, Any] | None = None, *,
+             start_time: float = 0.0, rtol: float = 1e-6, atol: float = 1e-8,
+             max_step: float | None = None, max_steps: int = 100000, solver: str = "idas",
+             outputs: Sequence[str] | None = None,
+             progress: Callable[[float], None] | None = None) -> Result:
+    """Simulate ``model`` from ``start_time`` to ``stop_time`` [s].
+
+    interval: output grid step [s] (default: 500 intervals). params: overrides by dotted name
+    of parameters, model inputs (held constant) or start values of variables. rtol/atol:
+    integrator tolerances; max_step: largest internal step [s]. solver: "idas" (default) or
+    "cvodes" (ODE models only). outputs: names to record (default: every variable).
+    progress: called with the fraction done after each chunk of the run.
+    """
+    compiled = model if isinstance(model, CompiledModel) else compile(model)
+    dae = compiled.dae
+    t_start = _time.perf_counter()
+    p_over, start_over = _split_overrides(dae, params or {})
+    p = dae.p_vector(p_over)
+    if start_over:
+        dae = _with_starts(dae, start_over)
+    if stop_time <= start_time:
+        raise ParameterError(f"stop_time ({stop_time}) must be after start_time ({start_time})")
+    n_int = max(1, int(round((stop_time - start_time) / interval))) if interval else 500
+    grid = np.linspace(start_time, stop_time, n_int + 1)
+    init = initialize(dae, p, start_time)
+    obs_idx = _output_indices(dae, outputs)
+    observe = _observer(dae, obs_idx)
+    opts = {"abstol": atol, "reltol": rtol, "max_num_steps": max_steps}
+    if max_step is not None:
+        opts["max_step_size"] = float(max_step)
+    xs, zs, stats, failure = _integrate(dae, solver, grid, init.x0, init.z0, p, opts, progress)
+    n_ok = xs.shape[1]
+    values = np.asarray(observe(grid[:n_ok], xs, zs, p)) if n_ok else np.zeros((0, len(obs_idx)))
+    run = _time.perf_counter() - t_start
+    names = [dae.names[k] for k in obs_idx]
+    flat = compiled.reduced.model
+    units = {v.name: v.decl.unit for v in flat.variables}
+    params_out = {q.name: float(val) for q, val in zip(dae.parameters, p, strict=False)}
+    result = Result(grid[:n_ok], values, names, dict(flat.aliases) if outputs is None else {},
+                    params_out, units,
+                    {"compile_seconds": compiled.compile_time, "run_seconds": run,
+                     "timings": dict(compiled.timings), "solver": solver, "stats": stats,
+                     "states": list(dae.state_names), "init_notes": init.notes})
+    if failure is not None:
+        t_reached = float(grid[n_ok - 1]) if n_ok else start_time
+        hint = next((h for key, h in _HINTS.items() if key in failure), "see the solver message")
+        raise SimulationError(
+            f"{solver.upper()} failed after t = {t_reached:g} s (last good output point): "
+            f"{hint}.\nSolver said: {failure.strip().splitlines()[-1][:300]}",
+            t_reached, result)
+    return result
+
+
+def _split_overrides(dae: CasadiDAE, params: dict[str, Any]):
+    pnames = {p.name for p in dae.parameters} | {u.name for u in dae.inputs}
+    p_over = {k: v for k, v in params.items() if k in pnames}
+    start_over = {k: v for k, v in params.items() if k not in pnames and k in dae.observed_index}
+    unknown = {k: v for k, v in params.items() if k not in pnames and k not in start_over}
+    p_over.update(unknown)        # p_vector reports unknown names
+    return p_over, start_over
+
+
+def _with_starts(dae: CasadiDAE, overrides: dict[str, Any]) -> CasadiDAE:
+    from dataclasses import replace
+
+    from .backends.casadi_dae import _number
+
+    fixed = dict(dae.fixed)
+    x_start, z_start = dae.x_start.copy(), dae.z_start.copy()
+    for name, value in overrides.items():
+        k = dae.observed_index[name]
+        fixed[k] = _number(name, value)
+        if name in dae.state_names:
+            x_start[dae.state_names.index(name)] = fixed[k]
+    return replace(dae, fixed=sorted(fixed.items()), x_start=x_start, z_start=z_start)
+
+
+def _output_indices(dae: CasadiDAE, outputs: Sequence[str] | None) -> list[int]:
+    if outputs is None:
+        return list(range(len(dae.names)))
+    missing = [n for n in outputs if n not in dae.observed_index]
+    if missing:
+        raise ParameterError(f"unknown output variable(s): {', '.join(missing)}")
+    return [dae.observed_index[n] for n in outputs]
+
+
+def _observer(dae: CasadiDAE, idx: list[int]) -> Callable:
+    expr = ca.vertcat(*[dae.observed[k] for k in idx]) if idx else ca.SX(0, 1)
+    f = ca.Function("observe", [dae.t, dae.x, dae.z, dae.p], [expr])
+
+    def run(times, xs, zs, p):
+        n = len(times)
+        fm = f.map(n)
+        out = fm(times.reshape(1, -1), xs, zs if zs.size else np.zeros((0, n)),
+                 np.repeat(np.asarray(p).reshape(-1, 1), n, axis=1))
+        return np.asarray(out).T.reshape(n, len(idx))
+
+    return run
+
+
+def _integrator(dae: CasadiDAE, solver: str, t0: float, tout: np.ndarray, opts: dict):
+    x, ode = dae.x, dae.ode
+    if x.numel() == 0:                      # purely algebraic model: integrate a dummy state
+        x, ode = ca.SX.sym("_dummy"), ca.SX(0)
+    problem = {"x": x, "p": dae.p, "t": dae.t, "ode": ode}
+    if dae.z.numel():
+        if solver != "idas":
+            raise ParameterError(f"solver {solver!r} cannot handle the algebraic variables "
+                                 f"{', '.join(dae.algebraic_names[:5])}; use 'idas'")
+        problem.update(z=dae.z, alg=dae.alg)
+    return ca.integrator("sim", solver, problem, float(t0), list(map(float, tout)), opts)
+
+
+def _integrate(dae: CasadiDAE, solver: str, grid: np.ndarray, x0, z0, p, opts, progress):
+    nx = max(dae.x.numel(), 1)
+    x0 = x0 if dae.x.numel() else np.zeros(1)
+    chunks = [grid] if progress is None else np.array_split(grid, min(20, len(grid) - 1))
+    if progress is not None:          # overlapping chunks: each starts where the last ended
+        chunks = [np.concatenate(([chunks[k - 1][-1]], c)) if k else c
+                  for k, c in enumerate(chunks)]
+    xs, zs = [x0.reshape(nx, 1)], [np.asarray(z0).reshape(-1, 1)]
+    stats: dict[str, Any] = {}
+    failure = None
+    xk, zk = x0, z0
+    for chunk in chunks:
+        if len(chunk) < 2:
+            continue
+        try:
+            F = _integrator(dae, solver, chunk[0], chunk[1:], opts)
+            out = F(x0=xk, z0=zk, p=p)
+        except RuntimeError as err:
+            failure = str(err)
+            break
+        xf = np.asarray(out["xf"]).reshape(nx, -1)
+        zf = np.asarray(out["zf"]).reshape(len(z0), -1) if len(z0) else np.zeros((0, xf.shape[1]))
+        xs.append(xf)
+        zs.append(zf)
+        xk, zk = xf[:, -1], zf[:, -1] if len(z0) else z0
+        for key, val in F.stats().items():
+            if isinstance(val, (int, float)) and not isinstance(val, bool):
+                stats[key] = stats.get(key, 0) + val
+        if progress is not None:
+            progress(float((chunk[-1] - grid[0]) / (grid[-1] - grid[0])))
+    if failure is not None and progress is None and len(grid) > 2:
+        return _integrate(dae, solver, grid, x0, z0, p, opts, lambda _f: None)
+    X = np.hstack(xs)[: dae.x.numel()] if dae.x.numel() else np.zeros((0, sum(
+        a.shape[1] for a in xs)))
+    Z = np.hstack(zs)
+    return X, Z, stats, failure

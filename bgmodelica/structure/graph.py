@@ -1,0 +1,147 @@
+"""The integer equation graph shared by all structural algorithms."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+
+@dataclass
+class EquationGraph:
+    """Bipartite incidence of a DAE plus time-derivative links.
+
+    ``eq_vars[i]`` lists the variables incident in equation ``i``. ``var_derivative[j]`` is
+    the index of the variable that is the time derivative of variable ``j`` (or -1), and
+    ``eq_derivative[i]`` the index of the equation obtained by differentiating equation ``i``
+    (or -1). Empty link lists are filled with -1 on construction.
+    """
+
+    eq_vars: list[list[int]]
+    n_vars: int
+    var_derivative: list[int] = field(default_factory=list)
+    eq_derivative: list[int] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if not self.var_derivative and self.n_vars:
+            self.var_derivative = [-1] * self.n_vars
+        if not self.eq_derivative and self.eq_vars:
+            self.eq_derivative = [-1] * len(self.eq_vars)
+
+    @property
+    def n_eqs(self) -> int:
+        """Number of equations."""
+        return len(self.eq_vars)
+
+    def validate(self) -> None:
+        """Raise ``ValueError`` if indices are out of range or derivative links are
+        inconsistent (non-injective or cyclic)."""
+        n, m = self.n_vars, self.n_eqs
+        if len(self.var_derivative) != n:
+            raise ValueError(f"var_derivative has {len(self.var_derivative)} entries, not {n}")
+        if len(self.eq_derivative) != m:
+            raise ValueError(f"eq_derivative has {len(self.eq_derivative)} entries, not {m}")
+        for i, vs in enumerate(self.eq_vars):
+            for v in vs:
+                if not 0 <= v < n:
+                    raise ValueError(f"equation {i} references variable {v} out of range")
+        _inverse(self.var_derivative, n, "variable")
+        _inverse(self.eq_derivative, m, "equation")
+        self.var_orders()
+        self.eq_orders()
+
+    def var_eqs(self) -> list[list[int]]:
+        """Transpose: the equations each variable occurs in."""
+        out: list[list[int]] = [[] for _ in range(self.n_vars)]
+        for i, vs in enumerate(self.eq_vars):
+            for v in vs:
+                out[v].append(i)
+        return out
+
+    def var_integral(self) -> list[int]:
+        """Inverse of ``var_derivative``: var -> the variable it is the derivative of, or -1."""
+        return _inverse(self.var_derivative, self.n_vars, "variable")
+
+    def eq_integral(self) -> list[int]:
+        """Inverse of ``eq_derivative``: eq -> the equation it is the derivative of, or -1."""
+        return _inverse(self.eq_derivative, self.n_eqs, "equation")
+
+    def var_orders(self) -> list[int]:
+        """Derivative order of every variable (0 for a variable that is no derivative)."""
+        return _orders(self.var_derivative, self.var_integral(), "variable")
+
+    def eq_orders(self) -> list[int]:
+        """Number of differentiations that produced each equation (0 for an original one)."""
+        return _orders(self.eq_derivative, self.eq_integral(), "equation")
+
+    def base_vars(self) -> list[int]:
+        """Order-0 ancestor of every variable (itself for an order-0 variable)."""
+        integral = self.var_integral()
+        base = list(range(self.n_vars))
+        for j in range(self.n_vars):
+            if integral[j] == -1:
+                k = self.var_derivative[j]
+                while k != -1:
+                    base[k] = j
+                    k = self.var_derivative[k]
+        return base
+
+    def derivative_order(self, var: int) -> int:
+        """How many times ``var`` is differentiated from its order-0 ancestor (O(n_vars))."""
+        integral = self.var_integral()
+        order = 0
+        while integral[var] != -1:
+            var = integral[var]
+            order += 1
+        return order
+
+    def highest_derivative(self, var: int) -> int:
+        """The highest existing derivative of ``var`` (``var`` itself if it has none)."""
+        while self.var_derivative[var] != -1:
+            var = self.var_derivative[var]
+        return var
+
+    def is_highest(self, var: int) -> bool:
+        """True if ``var`` has no derivative variable."""
+        return self.var_derivative[var] == -1
+
+    def active_equations(self) -> list[int]:
+        """Equations that have not been differentiated (the highest-order ones)."""
+        return [i for i, d in enumerate(self.eq_derivative) if d == -1]
+
+    def copy(self) -> EquationGraph:
+        """Deep copy (lists are copied)."""
+        return EquationGraph(
+            [list(vs) for vs in self.eq_vars],
+            self.n_vars,
+            list(self.var_derivative),
+            list(self.eq_derivative),
+        )
+
+
+def _inverse(links: list[int], n: int, what: str) -> list[int]:
+    inv = [-1] * n
+    for i, d in enumerate(links):
+        if d == -1:
+            continue
+        if not 0 <= d < n:
+            raise ValueError(f"{what} {i} has derivative {d} out of range")
+        if d == i or inv[d] != -1:
+            raise ValueError(f"{what} {d} is the derivative of more than one {what}")
+        inv[d] = i
+    return inv
+
+
+def _orders(links: list[int], inv: list[int], what: str) -> list[int]:
+    n = len(links)
+    order = [-1] * n
+    seen = 0
+    for j in range(n):
+        if inv[j] == -1:
+            k, o = j, 0
+            while k != -1:
+                order[k] = o
+                seen += 1
+                o += 1
+                k = links[k]
+    if seen != n:
+        raise ValueError(f"cyclic {what} derivative links")
+    return order

@@ -1,0 +1,1 @@
+"""The bgmodelica component library: electrical, rotational, blocks, bond graphs, examples."""
