@@ -103,10 +103,11 @@ def sort_equations(reduced: ReducedModel) -> SortedDAE:
 
 def _loop(out: SortedDAE, eqs, cols, eq_cols, res, sym, unknowns, names, variables) -> None:
     cache: dict[tuple[int, int], ca.SX | None] = {}
+    var_hashes = {v.sx.element_hash() for v in variables}
 
     def solved(e: int, c: int) -> ca.SX | None:
         if (e, c) not in cache:
-            cache[(e, c)] = solve_linear_scalar(res[e], sym[c])
+            cache[(e, c)] = solve_linear_scalar(res[e], sym[c], var_hashes)
         return cache[(e, c)]
 
     torn = tear(eqs, cols, eq_cols, lambda e, c: solved(e, c) is not None)

@@ -30,8 +30,14 @@ def time_derivative(residual: ca.SX, syms: Sequence[ca.SX], rates: Sequence[ca.S
     return ca.simplify(out) if out.numel() == 1 else out
 
 
-def solve_linear_scalar(residual: ca.SX, var: ca.SX) -> ca.SX | None:
-    """``var`` from ``residual(var) = 0`` when the residual is linear in ``var``, else None."""
+def solve_linear_scalar(residual: ca.SX, var: ca.SX,
+                        variables: set[int] | None = None) -> ca.SX | None:
+    """``var`` from ``residual(var) = 0`` when the residual is linear in ``var``, else None.
+
+    With ``variables`` (SX hashes of the model's variables), only solve when the coefficient
+    of ``var`` is free of variables, so the division can never be by a vanishing quantity
+    (the safe choice for tearing).
+    """
     if residual.is_op(ca.OP_SUB):
         lhs, rhs = residual.dep(0), residual.dep(1)
         if ca.is_equal(lhs, var) and not ca.depends_on(rhs, var):
@@ -42,6 +48,8 @@ def solve_linear_scalar(residual: ca.SX, var: ca.SX) -> ca.SX | None:
     if ca.depends_on(a, var):
         return None
     if a.is_zero():
+        return None
+    if variables is not None and any(s.element_hash() in variables for s in ca.symvar(a)):
         return None
     b = ca.substitute(residual, var, ca.SX(0))
     return -b / a
