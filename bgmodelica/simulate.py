@@ -59,7 +59,8 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
     init = initialize(dae, p, start_time)
     obs_idx = _output_indices(dae, outputs)
     observe = _observer(dae, obs_idx)
-    opts = {"abstol": atol, "reltol": rtol, "max_num_steps": max_steps}
+    opts = {"abstol": atol, "reltol": rtol, "max_num_steps": max_steps,
+            "calc_ic": False}   # initialize() already made x0, z0 consistent
     if max_step is not None:
         opts["max_step_size"] = float(max_step)
     xs, zs, stats, failure = _integrate(dae, solver, grid, init.x0, init.z0, p, opts, progress)
@@ -145,6 +146,12 @@ def _integrator(dae: CasadiDAE, solver: str, t0: float, tout: np.ndarray, opts: 
     return ca.integrator("sim", solver, problem, float(t0), list(map(float, tout)), opts)
 
 
+def _xdot(dae: CasadiDAE, t: float, x, z, p) -> list[float]:
+    """Consistent initial state derivative for IDAS (we skip IDACalcIC: x0, z0 are solved)."""
+    f = ca.Function("xdot0", [dae.t, dae.x, dae.z, dae.p], [dae.ode])
+    return [float(v) for v in np.asarray(f(t, x, z, p)).ravel()]
+
+
 def _integrate(dae: CasadiDAE, solver: str, grid: np.ndarray, x0, z0, p, opts, progress):
     nx = max(dae.x.numel(), 1)
     x0 = x0 if dae.x.numel() else np.zeros(1)
@@ -160,7 +167,10 @@ def _integrate(dae: CasadiDAE, solver: str, grid: np.ndarray, x0, z0, p, opts, p
         if len(chunk) < 2:
             continue
         try:
-            F = _integrator(dae, solver, chunk[0], chunk[1:], opts)
+            chunk_opts = dict(opts)
+            if solver == "idas" and dae.x.numel():
+                chunk_opts["init_xdot"] = _xdot(dae, chunk[0], xk, zk, p)
+            F = _integrator(dae, solver, chunk[0], chunk[1:], chunk_opts)
             out = F(x0=xk, z0=zk, p=p)
         except RuntimeError as err:
             failure = str(err)
