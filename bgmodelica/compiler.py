@@ -85,6 +85,26 @@ def compile(model: Component, *, select: Selector | None = None) -> CompiledMode
     lap("alias")
     balance = check_balance(flat)
     lap("balance")
+    return _reduce_and_build(flat, balance, n_flat, timings, model, select)
+
+
+def recompile(compiled: CompiledModel, select: Selector) -> CompiledModel:
+    """The same model with another state selection (index reduction onwards)."""
+    return _reduce_and_build(compiled.flat, compiled.balance, compiled.n_flat_equations, {},
+                             compiled.source, select)
+
+
+def _reduce_and_build(flat: FlatModel, balance: BalanceReport, n_flat: int,
+                      timings: dict[str, float], source: Any,
+                      select: Selector | None) -> CompiledModel:
+    t = _time.perf_counter()
+
+    def lap(stage: str) -> None:
+        nonlocal t
+        now = _time.perf_counter()
+        timings[stage] = now - t
+        t = now
+
     reduced = reduce_index(flat, select=select)
     lap("index_reduction")
     sorted_dae = sort_equations(reduced)
@@ -92,4 +112,4 @@ def compile(model: Component, *, select: Selector | None = None) -> CompiledMode
     dae = build_dae(sorted_dae)
     lap("backend")
     return CompiledModel(flat.name, flat, balance, reduced, sorted_dae, dae, n_flat, timings,
-                         model)
+                         source)

@@ -35,7 +35,7 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
              interval: float | None = None, params: dict[str, Any] | None = None, *,
              start_time: float = 0.0, rtol: float = 1e-6, atol: float = 1e-8,
              max_step: float | None = None, max_steps: int = 100000, solver: str = "idas",
-             outputs: Sequence[str] | None = None,
+             outputs: Sequence[str] | None = None, dynamic: bool = True,
              progress: Callable[[float], None] | None = None) -> Result:
     """Simulate ``model`` from ``start_time`` to ``stop_time`` [s].
 
@@ -43,6 +43,8 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
     of parameters, model inputs (held constant) or start values of variables. rtol/atol:
     integrator tolerances; max_step: largest internal step [s]. solver: "idas" (default) or
     "cvodes" (ODE models only). outputs: names to record (default: every variable).
+    dynamic: allow dynamic state selection when index reduction left a choice whose
+    conditioning depends on the state (see :mod:`bgmodelica.dynamic_selection`).
     progress: called with the fraction done after each chunk of the run.
     """
     compiled = model if isinstance(model, CompiledModel) else compile(model)
@@ -63,19 +65,30 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
             "calc_ic": False}   # initialize() already made x0, z0 consistent
     if max_step is not None:
         opts["max_step_size"] = float(max_step)
-    xs, zs, stats, failure = _integrate(dae, solver, grid, init.x0, init.z0, p, opts, progress)
-    n_ok = xs.shape[1]
-    values = np.asarray(observe(grid[:n_ok], xs, zs, p)) if n_ok else np.zeros((0, len(obs_idx)))
+    selector = _selector(compiled) if dynamic else None
+    if selector is not None:
+        values, stats, failure, variants = _integrate_dynamic(selector, grid, init, p, opts,
+                                                              progress)
+        values = values[:, obs_idx]
+        n_ok = values.shape[0]
+    else:
+        xs, zs, stats, failure = _integrate(dae, solver, grid, init.x0, init.z0, p, opts,
+                                            progress)
+        n_ok = xs.shape[1]
+        values = (np.asarray(observe(grid[:n_ok], xs, zs, p)) if n_ok
+                  else np.zeros((0, len(obs_idx))))
     run = _time.perf_counter() - t_start
     names = [dae.names[k] for k in obs_idx]
     flat = compiled.reduced.model
     units = {v.name: v.decl.unit for v in flat.variables}
     params_out = {q.name: float(val) for q, val in zip(dae.parameters, p, strict=False)}
+    meta = {"compile_seconds": compiled.compile_time, "run_seconds": run,
+            "timings": dict(compiled.timings), "solver": solver, "stats": stats,
+            "states": list(dae.state_names), "init_notes": init.notes}
+    if selector is not None:
+        meta["state_switches"] = selector.switches
     result = Result(grid[:n_ok], values, names, dict(flat.aliases) if outputs is None else {},
-                    params_out, units,
-                    {"compile_seconds": compiled.compile_time, "run_seconds": run,
-                     "timings": dict(compiled.timings), "solver": solver, "stats": stats,
-                     "states": list(dae.state_names), "init_notes": init.notes})
+                    params_out, units, meta)
     if failure is not None:
         t_reached = float(grid[n_ok - 1]) if n_ok else start_time
         hint = next((h for key, h in _HINTS.items() if key in failure), "see the solver message")
@@ -191,3 +204,79 @@ def _integrate(dae: CasadiDAE, solver: str, grid: np.ndarray, x0, z0, p, opts, p
         a.shape[1] for a in xs)))
     Z = np.hstack(zs)
     return X, Z, stats, failure
+
+
+def _selector(compiled: CompiledModel):
+    if not compiled.reduced.has_choice:
+        return None
+    from .dynamic_selection import StateSelector
+
+    cached = getattr(compiled, "_selector", None)
+    if cached is None:
+        cached = StateSelector(compiled)
+        cached = cached if cached.needed() else False
+        object.__setattr__(compiled, "_selector", cached)
+    return cached or None
+
+
+class _Stepper:
+    """One IDAS integrator over a single output interval, reused through a time offset."""
+
+    def __init__(self, dae: CasadiDAE, h: float, opts: dict) -> None:
+        t_off = ca.SX.sym("t_offset")
+        tau = ca.SX.sym("tau")
+        ode = ca.substitute(dae.ode, dae.t, tau + t_off)
+        problem = {"x": dae.x, "p": ca.vertcat(dae.p, t_off), "t": tau, "ode": ode}
+        if dae.z.numel():
+            problem.update(z=dae.z, alg=ca.substitute(dae.alg, dae.t, tau + t_off))
+        self.F = ca.integrator("step", "idas", problem, 0.0, [float(h)],
+                               {**opts, "calc_ic": True})
+        self.obs = ca.Function("observe_all", [dae.t, dae.x, dae.z, dae.p], [dae.observed])
+        self.dae = dae
+
+    def observe(self, t: float, x, z, p) -> np.ndarray:
+        return np.asarray(self.obs(t, x, z, p)).ravel()
+
+
+def _integrate_dynamic(selector, grid, init, p, opts, progress):
+    """Integrate interval by interval, re-selecting states where the choice degrades."""
+    h = float(grid[1] - grid[0])
+    steppers: dict[int, _Stepper] = {}
+
+    def stepper(c: CompiledModel) -> _Stepper:
+        if id(c) not in steppers:
+            steppers[id(c)] = _Stepper(c.dae, h, opts)
+        return steppers[id(c)]
+
+    def restart(c: CompiledModel, v: np.ndarray):
+        idx = c.dae.observed_index
+        return (np.array([v[idx[n]] for n in c.dae.state_names]),
+                np.array([v[idx[n]] for n in c.dae.algebraic_names]))
+
+    current = selector.base
+    xk, zk = init.x0, init.z0
+    values = [stepper(current).observe(grid[0], xk, zk, p)]
+    nxt = selector.check(current, values[-1], p, float(grid[0]))
+    if nxt is not current:
+        current, (xk, zk) = nxt, restart(nxt, values[-1])
+    stats: dict[str, Any] = {}
+    failure = None
+    for k in range(1, len(grid)):
+        st = stepper(current)
+        try:
+            out = st.F(x0=xk, z0=zk, p=np.concatenate([p, [grid[k - 1]]]))
+        except RuntimeError as err:
+            failure = str(err)
+            break
+        xk = np.asarray(out["xf"]).ravel()
+        zk = np.asarray(out["zf"]).ravel()
+        for key, val in st.F.stats().items():
+            if isinstance(val, (int, float)) and not isinstance(val, bool):
+                stats[key] = stats.get(key, 0) + val
+        values.append(st.observe(grid[k], xk, zk, p))
+        nxt = selector.check(current, values[-1], p, float(grid[k]))
+        if nxt is not current:
+            current, (xk, zk) = nxt, restart(nxt, values[-1])
+        if progress is not None and k % max(1, len(grid) // 20) == 0:
+            progress(k / (len(grid) - 1))
+    return np.vstack(values), stats, failure, selector.variants

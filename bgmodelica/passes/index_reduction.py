@@ -41,6 +41,7 @@ class ReducedModel:
     index: int
     has_choice: bool
     levels: list
+    priority: list[int]
 
 
 def reduce_index(model: FlatModel, select: Selector | None = None) -> ReducedModel:
@@ -93,7 +94,8 @@ def reduce_index(model: FlatModel, select: Selector | None = None) -> ReducedMod
     except StructuralError as err:
         raise UnbalancedModelError(f"state selection for {model.name} failed: {err}") from None
     return ReducedModel(aug, exact, list(dd.states), list(dd.dummies),
-                        list(pant.new_equations), _index(pant), dd.has_choice, dd.levels)
+                        list(pant.new_equations), _index(pant), dd.has_choice, dd.levels,
+                        priority)
 
 
 def _index(pant) -> int:

@@ -1,0 +1,102 @@
+"""Dynamic state selection: change the dummy derivatives when the current choice degenerates.
+
+Index reduction may leave a choice between candidate states (the Cartesian pendulum: x or y).
+When the Jacobian of the differentiated constraints with respect to the candidates depends on
+the variables, no fixed choice is good everywhere: solving ``x^2 + y^2 = L^2`` for ``y`` fails at
+``y = 0``. The simulation therefore checks, at every output point, the pivots of the current
+choice against the best numerical choice (QR with column pivoting at each dummy-derivative
+level) and, when the current one has fallen below ``threshold`` times the best, recompiles the
+model with the better selection (cached) and continues from the current values of all
+variables. This is Mattsson & Söderlind's dynamic pivoting done between integrator restarts.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+import scipy.linalg
+
+from .compiler import CompiledModel, recompile
+from .core.variables import time
+from .structure import dummy_derivatives
+from .structure.errors import StructuralError
+
+
+@dataclass
+class StateSelector:
+    """Numerical state selection for a compiled model whose structure leaves a choice."""
+
+    base: CompiledModel
+    threshold: float = 0.3
+    variants: dict[tuple[int, ...], CompiledModel] = field(default_factory=dict)
+    switches: list[tuple[float, list[str]]] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        red = self.base.reduced
+        model = red.model
+        syms = ca.vertcat(*[v.sx for v in model.variables])
+        res = ca.vertcat(*[e.residual for e in model.equations])
+        jac = ca.jacobian(res, syms)
+        bound = [p for p in model.parameters if isinstance(p.decl.value, ca.SX)]
+        if bound:
+            _, (jac,) = ca.substitute_inplace(
+                [ca.vertcat(*[p.sx for p in bound])],
+                [ca.vertcat(*[ca.SX(p.decl.value) for p in bound])], [jac], False)
+        free = [p for p in model.parameters if not isinstance(p.decl.value, ca.SX)]
+        p_vec = ca.vertcat(*[p.sx for p in free], *[u.sx for u in model.inputs])
+        self._jac = ca.Function("selection_jacobian", [syms, p_vec, time], [jac])
+        self.variants[self.key(red.dummies)] = self.base
+        self.priority = red.priority
+
+    @staticmethod
+    def key(dummies: list[int]) -> tuple[int, ...]:
+        return tuple(sorted(dummies))
+
+    def needed(self) -> bool:
+        """True when some level's Jacobian depends on the variables (a choice can degrade)."""
+        red = self.base.reduced
+        model = red.model
+        syms = ca.vertcat(*[v.sx for v in model.variables])
+        for rows, cands, _ in red.levels:
+            if len(cands) <= len(rows):
+                continue
+            j = ca.jacobian(ca.vertcat(*[model.equations[r].residual for r in rows]),
+                            ca.vertcat(*[model.variables[c].sx for c in cands]))
+            if ca.depends_on(j, syms):
+                return True
+        return False
+
+    def _score(self, jac: np.ndarray, levels) -> float:
+        score = 1.0
+        for rows, _cands, chosen in levels:
+            score *= abs(np.linalg.det(jac[np.ix_(rows, chosen)]))
+        return score
+
+    def check(self, current: CompiledModel, values: np.ndarray, p: np.ndarray,
+              t: float) -> CompiledModel:
+        """Return the variant to continue with at time ``t`` given all variable values."""
+        jac = np.asarray(ca.DM(self._jac(values, p, t)))
+        red = current.reduced
+        now = self._score(jac, red.levels)
+
+        def numeric(level, rows, cands, default):
+            a = jac[np.ix_(rows, cands)]
+            _, _, piv = scipy.linalg.qr(a, pivoting=True, mode="economic")
+            return [cands[k] for k in piv[: len(rows)]]
+
+        try:
+            best = dummy_derivatives(red.graph, self.priority, select=numeric)
+        except StructuralError:
+            return current
+        best_score = self._score(jac, best.levels)
+        if now >= self.threshold * best_score:
+            return current
+        key = self.key(best.dummies)
+        if key not in self.variants:
+            choice = {lvl: chosen for lvl, (_, _, chosen) in enumerate(best.levels, start=1)}
+            self.variants[key] = recompile(self.base, lambda lvl, r, c, d: choice.get(lvl, d))
+        nxt = self.variants[key]
+        self.switches.append((t, list(nxt.dae.state_names)))
+        return nxt
