@@ -255,10 +255,18 @@ def _integrate_dynamic(selector, grid, init, p, opts, progress):
 
     current = selector.base
     xk, zk = init.x0, init.z0
-    values = [stepper(current).observe(grid[0], xk, zk, p)]
-    nxt = selector.check(current, values[-1], p, float(grid[0]))
+    first = stepper(current).observe(grid[0], xk, zk, p)
+    bad = ~np.isfinite(first)          # the default choice may be singular at the start
+    if bad.any():
+        starts = [float(getattr(v.decl, "start", 0.0)) for v in current.reduced.model.variables]
+        first[bad] = np.asarray(starts)[bad]
+    nxt = selector.check(current, first, p, float(grid[0]))
     if nxt is not current:
-        current, (xk, zk) = nxt, restart(nxt, values[-1])
+        current = nxt
+        again = initialize(current.dae, p, float(grid[0]))
+        xk, zk = again.x0, again.z0
+        first = stepper(current).observe(grid[0], xk, zk, p)
+    values = [first]
     stats: dict[str, Any] = {}
     failure = None
     for k in range(1, len(grid)):

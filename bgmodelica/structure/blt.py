@@ -6,6 +6,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from .diagnosis import check_structurally_nonsingular
+from .graph import gc_paused
 from .matching import Matching
 
 
@@ -22,6 +23,7 @@ class Block:
         return len(self.eqs)
 
 
+@gc_paused()
 def block_lower_triangular(
     eq_vars: Sequence[Sequence[int]], n_unknowns: int, matching: Matching | None = None
 ) -> list[Block]:
@@ -50,41 +52,38 @@ def block_lower_triangular(
         counter += 1
         scc_stack.append(root)
         on_stack[root] = True
-        work = [root]
-        ptrs = [0]
+        work = [(root, iter(eq_vars[root]))]
         while work:
-            u = work[-1]
-            p = ptrs[-1]
-            us = eq_vars[u]
-            if p < len(us):
-                ptrs[-1] = p + 1
-                w = var_to_eq[us[p]]
-                if w == u:
-                    continue
+            u, it = work[-1]
+            for v in it:
+                w = var_to_eq[v]
                 if index[w] == -1:
                     index[w] = low[w] = counter
                     counter += 1
                     scc_stack.append(w)
                     on_stack[w] = True
-                    work.append(w)
-                    ptrs.append(0)
-                elif on_stack[w] and index[w] < low[u]:
+                    work.append((w, iter(eq_vars[w])))
+                    break
+                if on_stack[w] and index[w] < low[u]:
                     low[u] = index[w]
-                continue
-            work.pop()
-            ptrs.pop()
-            if low[u] == index[u]:
-                comp = []
-                while True:
+            else:
+                work.pop()
+                lu = low[u]
+                if lu == index[u]:
                     w = scc_stack.pop()
                     on_stack[w] = False
-                    comp.append(w)
                     if w == u:
-                        break
-                comp.sort()
-                blocks.append(Block(comp, [eq_to_var[e] for e in comp]))
-            if work:
-                parent = work[-1]
-                if low[u] < low[parent]:
-                    low[parent] = low[u]
+                        blocks.append(Block([u], [eq_to_var[u]]))
+                    else:
+                        comp = [w]
+                        while w != u:
+                            w = scc_stack.pop()
+                            on_stack[w] = False
+                            comp.append(w)
+                        comp.sort()
+                        blocks.append(Block(comp, [eq_to_var[e] for e in comp]))
+                if work:
+                    parent = work[-1][0]
+                    if lu < low[parent]:
+                        low[parent] = lu
     return blocks

@@ -6,6 +6,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from .errors import StructurallySingular
+from .graph import gc_paused
 from .matching import Matching, maximum_matching
 
 
@@ -41,6 +42,7 @@ class DMDecomposition:
         )
 
 
+@gc_paused()
 def dulmage_mendelsohn(
     eq_vars: Sequence[Sequence[int]], n_vars: int, matching: Matching | None = None
 ) -> DMDecomposition:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 from .diagnosis import dulmage_mendelsohn
 from .errors import StateSelectionError, StructurallySingular
-from .graph import EquationGraph
+from .graph import EquationGraph, derivative_chains, gc_paused
 from .matching import preferred_column_matching
 
 NEVER, AVOID, DEFAULT, PREFER, ALWAYS = -2, -1, 0, 1, 2
@@ -41,6 +41,7 @@ class DummyDerivativeResult:
     has_choice: bool
 
 
+@gc_paused()
 def dummy_derivatives(
     graph: EquationGraph,
     priority: Sequence[int] | None = None,
@@ -65,11 +66,8 @@ def dummy_derivatives(
     n = graph.n_vars
     var_der = graph.var_derivative
     eq_vars = graph.eq_vars
-    var_int = graph.var_integral()
-    eq_int = graph.eq_integral()
-    var_order = graph.var_orders()
-    eq_order = graph.eq_orders()
-    base = graph.base_vars()
+    var_int, var_order, base = derivative_chains(var_der, "variable")
+    eq_int, eq_order, _ = derivative_chains(graph.eq_derivative, "equation")
     prio_list = list(priority) if priority is not None else []
 
     def prio(v: int) -> int:
@@ -80,8 +78,10 @@ def dummy_derivatives(
     for i, vs in enumerate(eq_vars):
         if eq_order[i] != 0:
             continue
-        pair = list(dict.fromkeys(vs))
-        if len(pair) != 2:
+        if len(vs) < 2:
+            continue
+        pair = list(vs) if len(vs) == 2 else list(dict.fromkeys(vs))
+        if len(pair) != 2 or pair[0] == pair[1]:
             continue
         for a, b in (pair, pair[::-1]):
             if var_order[a] == 1 and var_order[b] == 0 and base[a] != b:

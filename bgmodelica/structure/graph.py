@@ -2,7 +2,23 @@
 
 from __future__ import annotations
 
+import gc
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+
+
+@contextmanager
+def gc_paused() -> Iterator[None]:
+    """Pause the cyclic garbage collector (the graph algorithms allocate many small acyclic
+    lists, which makes it trigger often for nothing). Usable as a decorator."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
 
 
 @dataclass
@@ -39,14 +55,14 @@ class EquationGraph:
             raise ValueError(f"var_derivative has {len(self.var_derivative)} entries, not {n}")
         if len(self.eq_derivative) != m:
             raise ValueError(f"eq_derivative has {len(self.eq_derivative)} entries, not {m}")
-        for i, vs in enumerate(self.eq_vars):
-            for v in vs:
-                if not 0 <= v < n:
-                    raise ValueError(f"equation {i} references variable {v} out of range")
-        _inverse(self.var_derivative, n, "variable")
-        _inverse(self.eq_derivative, m, "equation")
-        self.var_orders()
-        self.eq_orders()
+        lo = min((min(vs) for vs in self.eq_vars if vs), default=0)
+        hi = max((max(vs) for vs in self.eq_vars if vs), default=-1)
+        if lo < 0 or hi >= n:
+            bad = next(i for i, vs in enumerate(self.eq_vars)
+                       if vs and (min(vs) < 0 or max(vs) >= n))
+            raise ValueError(f"equation {bad} references a variable out of range 0..{n - 1}")
+        derivative_chains(self.var_derivative, "variable")
+        derivative_chains(self.eq_derivative, "equation")
 
     def var_eqs(self) -> list[list[int]]:
         """Transpose: the equations each variable occurs in."""
@@ -66,23 +82,15 @@ class EquationGraph:
 
     def var_orders(self) -> list[int]:
         """Derivative order of every variable (0 for a variable that is no derivative)."""
-        return _orders(self.var_derivative, self.var_integral(), "variable")
+        return derivative_chains(self.var_derivative, "variable")[1]
 
     def eq_orders(self) -> list[int]:
         """Number of differentiations that produced each equation (0 for an original one)."""
-        return _orders(self.eq_derivative, self.eq_integral(), "equation")
+        return derivative_chains(self.eq_derivative, "equation")[1]
 
     def base_vars(self) -> list[int]:
         """Order-0 ancestor of every variable (itself for an order-0 variable)."""
-        integral = self.var_integral()
-        base = list(range(self.n_vars))
-        for j in range(self.n_vars):
-            if integral[j] == -1:
-                k = self.var_derivative[j]
-                while k != -1:
-                    base[k] = j
-                    k = self.var_derivative[k]
-        return base
+        return derivative_chains(self.var_derivative, "variable")[2]
 
     def derivative_order(self, var: int) -> int:
         """How many times ``var`` is differentiated from its order-0 ancestor (O(n_vars))."""
@@ -130,18 +138,25 @@ def _inverse(links: list[int], n: int, what: str) -> list[int]:
     return inv
 
 
-def _orders(links: list[int], inv: list[int], what: str) -> list[int]:
+def derivative_chains(links: list[int], what: str = "variable") -> tuple[
+        list[int], list[int], list[int]]:
+    """For derivative links (``links[j]`` = derivative of ``j`` or -1) return
+    ``(integral, order, root)``: the inverse links, the derivative order and the order-0
+    ancestor of every element. Raises ``ValueError`` for non-injective or cyclic links."""
     n = len(links)
+    inv = _inverse(links, n, what)
     order = [-1] * n
+    root = [-1] * n
     seen = 0
     for j in range(n):
         if inv[j] == -1:
             k, o = j, 0
             while k != -1:
                 order[k] = o
+                root[k] = j
                 seen += 1
                 o += 1
                 k = links[k]
     if seen != n:
         raise ValueError(f"cyclic {what} derivative links")
-    return order
+    return inv, order, root

@@ -12,6 +12,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from .graph import gc_paused
+
 _INF = 1 << 60
 
 
@@ -45,20 +47,22 @@ def _filtered_adjacency(
     eq_vars: Sequence[Sequence[int]],
     var_allowed: Sequence[bool] | None,
     eq_allowed: Sequence[bool] | None,
-) -> list[list[int]]:
+) -> Sequence[Sequence[int]]:
     if var_allowed is None:
-        adj = [list(vs) for vs in eq_vars]
+        if eq_allowed is None:
+            return eq_vars
+        adj: list[Sequence[int]] = list(eq_vars)
     else:
         adj = [[v for v in vs if var_allowed[v]] for vs in eq_vars]
     if eq_allowed is not None:
         for i, ok in enumerate(eq_allowed):
             if not ok:
-                adj[i] = []
+                adj[i] = ()
     return adj
 
 
 def _warm_start(
-    adj: list[list[int]], n_vars: int, initial: Matching
+    adj: Sequence[Sequence[int]], n_vars: int, initial: Matching
 ) -> tuple[list[int], list[int]]:
     """Copy the valid pairs of ``initial`` (edge present, both ends allowed)."""
     n_eqs = len(adj)
@@ -75,7 +79,7 @@ def _warm_start(
     return eq_to_var, var_to_eq
 
 
-def _greedy(adj: list[list[int]], eq_to_var: list[int], var_to_eq: list[int]) -> None:
+def _greedy(adj: Sequence[Sequence[int]], eq_to_var: list[int], var_to_eq: list[int]) -> None:
     for i, vs in enumerate(adj):
         if eq_to_var[i] == -1:
             for v in vs:
@@ -85,7 +89,9 @@ def _greedy(adj: list[list[int]], eq_to_var: list[int], var_to_eq: list[int]) ->
                     break
 
 
-def _hopcroft_karp(adj: list[list[int]], eq_to_var: list[int], var_to_eq: list[int]) -> None:
+def _hopcroft_karp(
+    adj: Sequence[Sequence[int]], eq_to_var: list[int], var_to_eq: list[int]
+) -> None:
     """Extend ``eq_to_var``/``var_to_eq`` in place to a maximum matching."""
     n_eqs = len(adj)
     while True:
@@ -155,6 +161,7 @@ def _hopcroft_karp(adj: list[list[int]], eq_to_var: list[int], var_to_eq: list[i
                         vs.pop()
 
 
+@gc_paused()
 def maximum_matching(
     eq_vars: Sequence[Sequence[int]],
     n_vars: int,
@@ -228,6 +235,7 @@ def augment(
     return False
 
 
+@gc_paused()
 def preferred_column_matching(
     eq_vars: Sequence[Sequence[int]], n_vars: int, preference: Sequence[int]
 ) -> Matching:

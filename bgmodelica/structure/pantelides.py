@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 from .diagnosis import dulmage_mendelsohn
 from .errors import IndexReductionFailed, StructurallySingular
-from .graph import EquationGraph
+from .graph import EquationGraph, derivative_chains, gc_paused
 from .matching import Matching, maximum_matching
 
 
@@ -46,22 +46,32 @@ class PantelidesResult:
     index: int
 
 
-def _family_check(graph: EquationGraph, var_order: list[int]) -> None:
+def _family_check(
+    graph: EquationGraph, var_order: list[int], base: list[int], highest: Matching
+) -> None:
     """Raise StructurallySingular unless active equations match variable families 1:1.
 
     This is the condition (a transversal of Pryce's signature matrix) under which Pantelides'
-    algorithm terminates.
+    algorithm terminates. The highest-derivative matching is a valid warm start since each
+    family has exactly one highest-derivative variable.
     """
-    base = graph.base_vars()
-    fam_id = [-1] * graph.n_vars
+    fam_of_base = [-1] * graph.n_vars
     families: list[int] = []
     for j in range(graph.n_vars):
         if var_order[j] == 0:
-            fam_id[j] = len(families)
+            fam_of_base[j] = len(families)
             families.append(j)
+    fam = [fam_of_base[b] for b in base]
     active = graph.active_equations()
-    fam_eqs = [list(dict.fromkeys(fam_id[base[v]] for v in graph.eq_vars[i])) for i in active]
-    m = maximum_matching(fam_eqs, len(families))
+    eq_vars = graph.eq_vars
+    fam_eqs = [[fam[v] for v in eq_vars[i]] for i in active]
+    start = Matching.empty(len(active), len(families))
+    for k, i in enumerate(active):
+        v = highest.eq_to_var[i]
+        if v != -1:
+            start.eq_to_var[k] = fam[v]
+            start.var_to_eq[fam[v]] = k
+    m = maximum_matching(fam_eqs, len(families), initial=start)
     if m.size == len(active) == len(families):
         return
     dm = dulmage_mendelsohn(fam_eqs, len(families), m)
@@ -74,6 +84,7 @@ def _family_check(graph: EquationGraph, var_order: list[int]) -> None:
     )
 
 
+@gc_paused()
 def pantelides(graph: EquationGraph, max_differentiations: int | None = None) -> PantelidesResult:
     """Run Pantelides' algorithm on a copy of ``graph``.
 
@@ -90,22 +101,21 @@ def pantelides(graph: EquationGraph, max_differentiations: int | None = None) ->
     """
     g = graph.copy()
     g.validate()
-    var_order = g.var_orders()
-    eq_order = g.eq_orders()
-    _family_check(g, var_order)
-
+    _, var_order, base = derivative_chains(g.var_derivative, "variable")
+    _, eq_order, _ = derivative_chains(g.eq_derivative, "equation")
     eq_vars = g.eq_vars
     var_der = g.var_derivative
     eq_der = g.eq_derivative
-    if max_differentiations is None:
-        max_var_order = max(var_order, default=0)
-        max_differentiations = (len(eq_vars) + 1) * max(1, max_var_order) + max(eq_order,
-                                                                                 default=0)
 
     highest = [d == -1 for d in var_der]
     active = [d == -1 for d in eq_der]
     m = maximum_matching(eq_vars, g.n_vars, highest, eq_allowed=active)
+    _family_check(g, var_order, base, m)
     eq_to_var, var_to_eq = m.eq_to_var, m.var_to_eq
+    if max_differentiations is None:
+        max_var_order = max(var_order, default=0)
+        max_differentiations = (len(eq_vars) + 1) * max(1, max_var_order) + max(
+            eq_order, default=0)
 
     new_equations: list[tuple[int, int]] = []
     new_variables: list[tuple[int, int]] = []

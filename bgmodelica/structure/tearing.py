@@ -12,6 +12,8 @@ from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
+from .graph import gc_paused
+
 
 @dataclass
 class Tearing:
@@ -23,6 +25,7 @@ class Tearing:
     causal: list[tuple[int, int]]
 
 
+@gc_paused()
 def tear(
     block_eqs: Sequence[int],
     block_vars: Sequence[int],
