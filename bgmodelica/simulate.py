@@ -181,6 +181,8 @@ def _integrate(dae: CasadiDAE, solver: str, grid: np.ndarray, x0, z0, p, opts, p
             continue
         try:
             chunk_opts = dict(opts)
+            if solver != "idas":
+                chunk_opts.pop("calc_ic", None)      # an IDAS-only option
             if solver == "idas" and dae.x.numel():
                 chunk_opts["init_xdot"] = _xdot(dae, chunk[0], xk, zk, p)
             F = _integrator(dae, solver, chunk[0], chunk[1:], chunk_opts)

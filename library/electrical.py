@@ -23,8 +23,8 @@ from bgmodelica.core.expressions import if_else
 from .rotational import Flange
 
 __all__ = ["Pin", "OnePort", "Ground", "Resistor", "Capacitor", "Inductor", "ConstantVoltage",
-           "StepVoltage", "SineVoltage", "SignalVoltage", "ConstantCurrent", "SignalCurrent",
-           "EMF", "VoltageSensor", "CurrentSensor"]
+           "StepVoltage", "SineVoltage", "SignalVoltage", "ConstantCurrent", "StepCurrent",
+           "SineCurrent", "SignalCurrent", "EMF", "VoltageSensor", "CurrentSensor"]
 
 
 class Pin(Connector):
@@ -140,6 +140,32 @@ class ConstantCurrent(OnePort):
 
     def equations(self):
         yield self.i == self.I
+
+
+class StepCurrent(OnePort):
+    """Current step ``i = offset + (time >= start_time ? I : 0)`` (from p to n through the
+    source). Parameters: I [A] height, offset [A], start_time [s]."""
+
+    I = Parameter(1.0, unit="A", description="Height of the step")  # noqa: E741
+    offset = Parameter(0.0, unit="A", description="Current before the step")
+    start_time = Parameter(0.0, unit="s", description="Time of the step")
+
+    def equations(self):
+        yield self.i == self.offset + if_else(time >= self.start_time, self.I, 0)
+
+
+class SineCurrent(OnePort):
+    """Sine current ``i = offset + I*sin(2*pi*f*time + phase)`` (from p to n through the
+    source). Parameters: I [A] amplitude, f [Hz] frequency, phase [rad], offset [A]."""
+
+    I = Parameter(1.0, unit="A", description="Amplitude")  # noqa: E741
+    f = Parameter(1.0, unit="Hz", description="Frequency")
+    phase = Parameter(0.0, unit="rad", description="Phase at time 0")
+    offset = Parameter(0.0, unit="A", description="Offset")
+
+    def equations(self):
+        yield self.i == self.offset + self.I * sin(2 * 3.141592653589793 * self.f * time
+                                                   + self.phase)
 
 
 class SignalCurrent(OnePort):

@@ -46,14 +46,17 @@ def initialize(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
     if conditions:
         cond_expr = ca.vertcat(*[dae.observed[k] for k, _ in conditions])
         xf = ca.vertcat(*[dae.x[i] for i in free]) if free else ca.SX(0, 1)
-        sp = ca.jacobian_sparsity(ca.vertcat(cond_expr, dae.alg),
+        sp = ca.jacobian_sparsity(ca.vertcat(dae.alg, cond_expr),
                                   ca.vertcat(xf, dae.z)) if free or nz else None
-        rows = [[] for _ in range(len(conditions) + nz)]
+        rows: list[list[int]] = [[] for _ in range(nz + len(conditions))]
         if sp is not None:
             for r, c in zip(*sp.get_triplet(), strict=True):
                 rows[r].append(c)
-        match = maximum_matching(rows, len(free) + nz)
-        surplus = [conditions[i][0] for i in range(len(conditions)) if match.eq_to_var[i] < 0]
+        # the model's own equations first: conditions compete for what they leave free
+        first = maximum_matching(rows[:nz] + [[] for _ in conditions], len(free) + nz)
+        match = maximum_matching(rows, len(free) + nz, initial=first)
+        surplus = [conditions[i][0] for i in range(len(conditions))
+                   if match.eq_to_var[nz + i] < 0]
         if surplus:
             names = ", ".join(dae.names[k] for k in surplus)
             raise InitializationError(

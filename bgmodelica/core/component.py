@@ -99,6 +99,11 @@ class Element:
                 f"{name!r} already exists")
         if not name.isidentifier():
             raise DeclarationError(f"{name!r} is not a valid component name")
+        if name not in type(self)._templates and callable(getattr(type(self), name, None)) \
+                or isinstance(getattr(type(self), name, None), property):
+            raise DeclarationError(
+                f"{name!r} cannot name a subcomponent of {type(self).__name__}: it is a method "
+                "of the class; choose another name")
         object.__setattr__(element, "_name", name)
         self._children[name] = element
         object.__setattr__(self, name, element)

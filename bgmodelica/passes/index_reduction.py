@@ -44,11 +44,20 @@ class ReducedModel:
     priority: list[int]
 
 
-def reduce_index(model: FlatModel, select: Selector | None = None) -> ReducedModel:
-    """Return the index-1 :class:`ReducedModel` of a balanced flat model."""
+def reduce_index(model: FlatModel | ReducedModel,
+                 select: Selector | None = None) -> ReducedModel:
+    """Return the index-1 :class:`ReducedModel` of a balanced flat model.
+
+    Given a :class:`ReducedModel` (whose differentiated equations are already present) it
+    differentiates nothing more: reduction is idempotent.
+    """
+    links: list[int] = []
+    if isinstance(model, ReducedModel):
+        links = list(model.graph.eq_derivative)
+        model = model.model
     syms = [v.sx for v in model.variables]
     eq_vars = incidence([e.residual for e in model.equations], syms)
-    graph = EquationGraph(eq_vars, len(syms), [v.der for v in model.variables])
+    graph = EquationGraph(eq_vars, len(syms), [v.der for v in model.variables], links)
     try:
         pant = pantelides(graph)
     except StructurallySingular as err:
@@ -83,7 +92,8 @@ def reduce_index(model: FlatModel, select: Selector | None = None) -> ReducedMod
                     if res.numel() else [])
     aug = FlatModel(model.name, variables, model.parameters, model.inputs, equations,
                     model.aliases)
-    eq_derivative = [-1] * len(equations)
+    eq_derivative = (links + [-1] * (len(equations) - len(links))) if links \
+        else [-1] * len(equations)
     for new, of in pant.new_equations:
         eq_derivative[of] = new
     exact = EquationGraph(rows, len(variables), [v.der for v in variables], eq_derivative)
