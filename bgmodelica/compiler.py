@@ -50,8 +50,8 @@ class CompiledModel:
             "flat_equations_before_alias_elimination": self.n_flat_equations,
             "aliases_eliminated": len(self.flat.aliases),
             "structural_index": red.index,
-            "differentiated_equations": [red.model.equations[i].origin
-                                         for i, _ in red.differentiated],
+            "differentiated_equations": [red.model.describe(of)
+                                         for _, of in red.differentiated],
             "states": [var[j].name for j in red.states],
             "dummy_derivatives": [var[j].name for j in red.dummies],
             "algebraic_variables": [var[j].name for j in srt.algebraic],
