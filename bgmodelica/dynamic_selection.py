@@ -19,7 +19,7 @@ import numpy as np
 import scipy.linalg
 
 from .compiler import CompiledModel, recompile
-from .core.variables import time
+from .core.variables import TIME
 from .structure import dummy_derivatives
 from .structure.errors import StructuralError
 
@@ -46,7 +46,7 @@ class StateSelector:
                 [ca.vertcat(*[ca.SX(p.decl.value) for p in bound])], [jac], False)
         free = [p for p in model.parameters if not isinstance(p.decl.value, ca.SX)]
         p_vec = ca.vertcat(*[p.sx for p in free], *[u.sx for u in model.inputs])
-        self._jac = ca.Function("selection_jacobian", [syms, p_vec, time], [jac])
+        self._jac = ca.Function("selection_jacobian", [syms, p_vec, TIME.sx], [jac])
         self.variants[self.key(red.dummies)] = self.base
         self.priority = red.priority
 

@@ -13,7 +13,7 @@ import casadi as ca
 import numpy as np
 
 from ..core.flatmodel import FlatVariable
-from ..core.variables import time
+from ..core.variables import TIME
 from ..errors import ParameterError
 from ..passes.sorting import SortedDAE
 
@@ -118,7 +118,7 @@ def build_dae(sorted_dae: SortedDAE) -> CasadiDAE:
     return CasadiDAE(
         x=ca.vertcat(*[variables[j].sx for j in states]),
         z=ca.vertcat(*[variables[j].sx for j in alg_vars]),
-        p=p if p.numel() else ca.SX(0, 1), t=time, ode=ode, alg=alg, observed=observed,
+        p=p if p.numel() else ca.SX(0, 1), t=TIME.sx, ode=ode, alg=alg, observed=observed,
         names=names, state_names=[variables[j].name for j in states],
         algebraic_names=[variables[j].name for j in alg_vars],
         parameters=free_params, inputs=list(model.inputs),

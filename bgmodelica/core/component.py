@@ -11,7 +11,8 @@ never call ``super().equations()``.
         def equations(self):
             yield self.v == self.R * self.i
 
-Every instance owns its own symbols: inside ``equations()`` ``self.R`` is a CasADi SX scalar.
+Every instance owns its own symbols: inside ``equations()`` ``self.R`` is an expression leaf
+(:mod:`bgmodelica.core.expr`), usable with Python operators and with CasADi functions.
 Modifiers at construction override a parameter value (``Resistor(R=10)``) or set a variable's
 start value, fixed by default (``Capacitor(v=1.0)``; ``Capacitor(v=dict(start=1, fixed=False))``
 makes it a guess). A dotted modifier reaches into subcomponents (``Motor(**{"R.R": 2})``).
@@ -26,6 +27,7 @@ from typing import Any, ClassVar
 import casadi as ca
 
 from ..errors import ConnectError, DeclarationError, DuplicateNameError
+from .expr import Leaf
 from .variables import (
     KIND_FLOW,
     KIND_INPUT,
@@ -75,7 +77,7 @@ class Element:
                 decl = decl.with_start(local.pop(key))
             sym = Symbol(key, decl, self)
             self._symbols[key] = sym
-            object.__setattr__(self, key, sym.sx)
+            object.__setattr__(self, key, sym.leaf)
         for key, template in type(self)._templates.items():
             child = template.clone()
             if key in local:
@@ -189,10 +191,19 @@ def connect(a: Any, b: Any) -> Connection:
     return Connection(a, b)
 
 
+def _symbol_of(x: Any) -> Symbol | None:
+    """The declared symbol behind a leaf expression or an SX symbol, else None."""
+    if isinstance(x, Leaf) and isinstance(x.sym, Symbol):
+        return x.sym
+    if isinstance(x, ca.SX) and x.numel() == 1 and x.is_symbolic():
+        return lookup(x)
+    return None
+
+
 def _describe(x: Any) -> str:
     if isinstance(x, Element):
         return f"{type(x).__name__} {x.name or '?'}"
-    sym = lookup(x) if isinstance(x, ca.SX) and x.is_symbolic() else None
+    sym = _symbol_of(x)
     return f"{sym.decl.kind} variable {sym.name}" if sym else repr(x)
 
 
@@ -218,7 +229,7 @@ def check_connectable(a: Any, b: Any) -> None:
         return
     syms = []
     for x in (a, b):
-        sym = lookup(x) if isinstance(x, ca.SX) and x.numel() == 1 and x.is_symbolic() else None
+        sym = _symbol_of(x)
         if sym is None:
             raise ConnectError(
                 f"cannot connect {_describe(a)} to {_describe(b)}: connect() joins two "

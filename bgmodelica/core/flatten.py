@@ -5,25 +5,29 @@ in the context of the component that owns it, and an *outside* element in its ow
 ``connect`` statements. In each set potentials are equal and flows sum to zero, inside flows
 counted positive and outside flows negative. A connector not connected as an inside element
 gets ``flow = 0``.
+
+Lowering to CasADi is vectorized: every symbol of the model becomes an element of one SX
+vector, and equations of the same shape are lowered together (see :mod:`.expr`).
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 import casadi as ca
 
 from ..errors import ConnectError, DeclarationError, EquationError
 from .component import Component, Connection, Connector, Element
-from .expressions import residual_of, signed_terms
+from .expr import Equation, Expr, Leaf, Number, lower_group, shape_of, to_sx
 from .flatmodel import FlatEquation, FlatModel, FlatVariable
 from .variables import (
     KIND_FLOW,
     KIND_INPUT,
     KIND_PARAMETER,
+    TIME,
     Symbol,
     lookup,
-    time,
 )
 
 
@@ -40,9 +44,11 @@ class _Flattener:
         self.paths: dict[int, str] = {}          # id(element) -> dotted path
         self.parents: dict[int, Element] = {}    # id(element) -> parent element
         self.elements: list[Element] = []
-        self.equations: list[FlatEquation] = []
         self.pending: list[tuple[Any, Component]] = []   # raw equations with context
         self.connections: list[tuple[Connection, Component]] = []
+        self.var_of: dict[int, int] = {}         # id(Symbol) -> variable index
+        self.pos: dict[int, int] = {}            # id(Symbol) -> position in self.all_sx
+        self.equations: list[FlatEquation] = []
 
     # -- tree walk -------------------------------------------------------------------------
     def run(self, name: str) -> FlatModel:
@@ -65,11 +71,11 @@ class _Flattener:
                         self.pending.append((eq, elem))
             for child_name, child in reversed(list(elem._children.items())):
                 stack.append((child, _join(path, child_name), elem))
-        variables, parameters, inputs, sym_index = self._collect_symbols()
+        variables, parameters, inputs, symbols = self._collect_symbols()
+        self._bind(symbols)
+        self._connection_equations()
         self._component_equations()
-        self._connection_equations(sym_index, variables)
-        self._check_references(variables, parameters, inputs)
-        self._mark_aliases(sym_index, variables)
+        parameters = [self._lower_binding(p) for p in parameters]
         return FlatModel(name, variables, parameters, inputs, self.equations)
 
     def where(self, elem: Element) -> str:
@@ -80,45 +86,65 @@ class _Flattener:
         variables: list[FlatVariable] = []
         parameters: list[FlatVariable] = []
         inputs: list[FlatVariable] = []
-        sym_index: dict[int, int] = {}     # SX hash -> variable index
+        symbols: list[tuple[Symbol, list, int]] = []      # (symbol, target list, index)
         top_connectors = {id(c) for c in self.top._children.values() if isinstance(c, Connector)}
         for elem in self.elements:
             path = self.paths[id(elem)]
             owner = path if isinstance(elem, Component) else path.rpartition(".")[0]
             for sym in elem._symbols.values():
                 full = _join(path, sym.name)
-                flat = FlatVariable(full, sym.sx, sym.decl, owner)
                 kind = sym.decl.kind
                 if kind == KIND_PARAMETER:
-                    parameters.append(flat)
+                    symbols.append((sym, parameters, len(parameters)))
+                    parameters.append(FlatVariable(full, None, sym.decl, owner))
                 elif kind == KIND_INPUT and (elem is self.top or id(elem) in top_connectors):
-                    inputs.append(flat)
+                    symbols.append((sym, inputs, len(inputs)))
+                    inputs.append(FlatVariable(full, None, sym.decl, owner))
                 else:
-                    sym_index[sym.sx.element_hash()] = len(variables)
-                    variables.append(flat)
-                    self._add_derivatives(sym, full, owner, variables, sym_index)
-        return variables, parameters, inputs, sym_index
+                    below = len(variables)
+                    self.var_of[id(sym)] = below
+                    symbols.append((sym, variables, below))
+                    variables.append(FlatVariable(full, None, sym.decl, owner))
+                    while sym.der is not None:             # derivative chain
+                        sym, full = sym.der, f"der({full})"
+                        variables[below].der = len(variables)
+                        self.var_of[id(sym)] = len(variables)
+                        symbols.append((sym, variables, len(variables)))
+                        variables.append(FlatVariable(full, None, sym.decl, owner, der_of=below))
+                        below = len(variables) - 1
+        return variables, parameters, inputs, symbols
 
-    @staticmethod
-    def _add_derivatives(sym: Symbol, full: str, owner: str, variables: list[FlatVariable],
-                         sym_index: dict[int, int]) -> None:
-        below = len(variables) - 1
-        while sym.der is not None:
-            sym = sym.der
-            full = f"der({full})"
-            variables[below].der = len(variables)
-            sym_index[sym.sx.element_hash()] = len(variables)
-            variables.append(FlatVariable(full, sym.sx, sym.decl, owner, der_of=below))
-            below = len(variables) - 1
+    def _bind(self, symbols) -> None:
+        """Give every symbol an SX scalar: fresh ones become elements of one SX vector."""
+        fresh = [s for s, _, _ in symbols if s._sx is None]
+        old = [s for s, _, _ in symbols if s._sx is not None]
+        big = ca.SX.sym("v", len(fresh))
+        for sym, sx in zip(fresh, ca.vertsplit(big) if fresh else [], strict=True):
+            sym.bind(sx)
+        for k, sym in enumerate(fresh):
+            self.pos[id(sym)] = k
+        for k, sym in enumerate(old):
+            self.pos[id(sym)] = len(fresh) + k
+        self.pos[id(TIME)] = len(fresh) + len(old)
+        self.all_sx = ca.vertcat(big, *[s.sx for s in old], TIME.sx)
+        for sym, target, index in symbols:
+            target[index].sx = sym.sx
 
-    # -- equations -------------------------------------------------------------------------
-    def _component_equations(self) -> None:
-        for eq, ctx in self.pending:
-            where = self.where(ctx)
-            for res in residual_of(eq, where):
-                self.equations.append(FlatEquation(res, where))
+    def _lower_binding(self, p: FlatVariable) -> FlatVariable:
+        if isinstance(p.decl.value, Expr):
+            for leaf_sym in _leaf_symbols(p.decl.value):
+                if id(leaf_sym) not in self.pos:
+                    raise DeclarationError(
+                        f"parameter {p.name} is bound to {p.decl.value!r}, which uses "
+                        f"{getattr(leaf_sym, 'name', leaf_sym)}: not part of this model")
+            return replace(p, decl=replace(p.decl, value=to_sx(p.decl.value)))
+        if not isinstance(p.decl.value, (Number, ca.SX)):
+            raise DeclarationError(f"parameter {p.name} has a non-numeric value "
+                                   f"{p.decl.value!r}")
+        return p
 
-    def _connection_equations(self, sym_index: dict[int, int], variables) -> None:
+    # -- connections -----------------------------------------------------------------------
+    def _connection_equations(self) -> None:
         parent: dict[tuple[int, int], tuple[int, int]] = {}
 
         def find(x):
@@ -131,7 +157,7 @@ class _Flattener:
             return root
 
         connectors: dict[int, Connector] = {}
-        signal_links: list[tuple[ca.SX, ca.SX, Component]] = []
+        signal_links: list[tuple[Any, Any, Component]] = []
         for conn, ctx in self.connections:
             ends = []
             for end in (conn.a, conn.b):
@@ -154,67 +180,207 @@ class _Flattener:
         sets: dict[tuple[int, int], list[tuple[int, int]]] = {}
         for key in list(parent):
             sets.setdefault(find(key), []).append(key)
+        pairs = _Pairs()
         for members in sets.values():
-            self._one_set(members, connectors, sym_index)
+            self._one_set(members, connectors, pairs)
         for a, b, ctx in signal_links:
-            self.equations.append(FlatEquation(a - b, f"connect in {self.where(ctx)}"))
+            sa, sb = _symbol(a), _symbol(b)
+            pairs.add(sa, sb, -1.0, f"connect in {self.where(ctx)}")
+        self._emit_pairs(pairs)
 
-    def _one_set(self, members, connectors, sym_index) -> None:
+    def _one_set(self, members, connectors, pairs: _Pairs) -> None:
         members.sort(key=lambda m: self.paths[m[0]])
         first = connectors[members[0][0]]
-        names = " -- ".join(self.paths[m[0]] for m in members)
-        origin = f"connection set {{{names}}}" if len(members) > 1 else (
-            f"unconnected connector {self.paths[members[0][0]]}")
+        if len(members) > 1:
+            names = " -- ".join(self.paths[m[0]] for m in members[:6])
+            more = f" -- ... ({len(members)} connectors)" if len(members) > 6 else ""
+            origin = f"connection set {{{names}{more}}}"
+        else:
+            origin = f"unconnected connector {self.paths[members[0][0]]}"
         for var_name, sym in first._symbols.items():
-            if sym.decl.kind == KIND_FLOW:
-                total = ca.SX(0)
-                for cid, side in members:
-                    total += (-1 if side else 1) * connectors[cid]._symbols[var_name].sx
-                self.equations.append(FlatEquation(total, origin))
+            syms = [connectors[cid]._symbols[var_name] for cid, _ in members]
+            if sym.decl.kind != KIND_FLOW:
+                for other in syms[1:]:
+                    pairs.add(syms[0], other, -1.0, origin)
+                continue
+            signs = [-1.0 if side else 1.0 for _, side in members]
+            if len(syms) == 2:
+                pairs.add(syms[0], syms[1], signs[0] * signs[1], origin)
             else:
-                ref = sym.sx
-                for cid, _ in members[1:]:
-                    other = connectors[cid]._symbols[var_name].sx
-                    self.equations.append(FlatEquation(ref - other, origin))
+                idx = [self.pos[id(s)] for s in syms]
+                total = ca.dot(self.all_sx[idx], ca.DM(signs)) if len(idx) > 1 \
+                    else self.all_sx[idx[0]]
+                self.equations.append(FlatEquation(total, origin))
 
-    # -- checks ----------------------------------------------------------------------------
-    def _check_references(self, variables, parameters, inputs) -> None:
-        if not self.equations:
+    def _emit_pairs(self, pairs: _Pairs) -> None:
+        """Residuals ``a + c*b`` of all two-symbol connection equations in one operation."""
+        if not pairs.a:
             return
-        known = {v.sx.element_hash() for v in variables}
-        known.update(p.sx.element_hash() for p in parameters)
-        known.update(u.sx.element_hash() for u in inputs)
-        known.add(time.element_hash())
-        for p in parameters:
-            value = p.decl.value
-            if isinstance(value, ca.SX):
-                for s in ca.symvar(value):
-                    if s.element_hash() not in known:
-                        raise DeclarationError(
-                            f"parameter {p.name} is bound to {value}, which uses {s}: "
-                            "not a parameter of this model")
-        for s in ca.symvar(ca.vertcat(*[e.residual for e in self.equations])):
+        ia = [self.pos[id(s)] for s in pairs.a]
+        ib = [self.pos[id(s)] for s in pairs.b]
+        res = self.all_sx[ia] + self.all_sx[ib] * ca.DM(pairs.coef)
+        for k, r in enumerate(ca.vertsplit(res)):
+            va, vb = self.var_of.get(id(pairs.a[k])), self.var_of.get(id(pairs.b[k]))
+            alias = (va, vb, -pairs.coef[k]) if va is not None and vb is not None else None
+            self.equations.append(FlatEquation(r, pairs.origin[k], alias))
+
+    # -- component equations ---------------------------------------------------------------
+    def _component_equations(self) -> None:
+        groups: dict[Any, list] = {}
+        slow: list[tuple[ca.SX, str]] = []
+        for eq, ctx in self.pending:
+            where = self.where(ctx)
+            if isinstance(eq, Equation):
+                if isinstance(eq.lhs, (ca.SX, ca.MX)) or isinstance(eq.rhs, (ca.SX, ca.MX)):
+                    slow.append((to_sx(eq.lhs) - to_sx(eq.rhs), where))
+                    continue
+                leaves: list = []
+                consts: list = []
+                try:
+                    key = (_side_shape(eq.lhs, leaves, consts),
+                           _side_shape(eq.rhs, leaves, consts))
+                except TypeError:
+                    raise EquationError(f"{where}: cannot use {eq!r} as an equation") from None
+                if not leaves:
+                    raise EquationError(f"{where}: equation {eq!r} has no variables")
+                groups.setdefault(key, []).append((leaves, consts, where, eq))
+            elif isinstance(eq, ca.SX) and eq.numel() >= 1 and all(
+                    eq[k].is_op(ca.OP_EQ) for k in range(eq.numel())):
+                for k in range(eq.numel()):
+                    slow.append((eq[k].dep(0) - eq[k].dep(1), where))
+            else:
+                raise EquationError(
+                    f"{where}: an equation must be written 'lhs == rhs' with at least one "
+                    f"variable, got {eq!r}")
+        for key, members in groups.items():
+            self._lower(key, members)
+        if slow:
+            self._check_slow(slow)
+            self.equations.extend(FlatEquation(r, where) for r, where in slow)
+
+    def _lower(self, key, members) -> None:
+        n_leaves = len(members[0][0])
+        idx = [[0] * len(members) for _ in range(n_leaves)]
+        for m, (leaves, _, where, eq) in enumerate(members):
+            for k, sym in enumerate(leaves):
+                p = self.pos.get(id(sym))
+                if p is None:
+                    owner = getattr(sym, "owner", None)
+                    raise EquationError(
+                        f"{where}: equation {eq!r} uses {getattr(sym, 'name', sym)}"
+                        + (f" of {type(owner).__name__}" if owner is not None else "")
+                        + ", which is not part of the model (add its component to the model)")
+                idx[k][m] = p
+        leaf_vecs = [self.all_sx[col] for col in idx]
+        const_vecs = []
+        for k in range(len(members[0][1])):
+            col = [m[1][k] for m in members]
+            const_vecs.append(col[0] if all(c == col[0] for c in col) else ca.DM(col))
+        shape_l, shape_r = key
+        n_l = _count_leaves(shape_l)
+        c_l = _count_consts(shape_l)
+        lhs = lower_group(shape_l, leaf_vecs[:n_l], const_vecs[:c_l])
+        rhs = lower_group(shape_r, leaf_vecs[n_l:], const_vecs[c_l:])
+        res = ca.SX(lhs - rhs)
+        parts = ca.vertsplit(res) if len(members) > 1 else [res]
+        for r, (leaves, _, where, eq) in zip(parts, members, strict=True):
+            self.equations.append(FlatEquation(r, where, self._alias(eq)))
+
+    def _alias(self, eq: Equation) -> tuple[int, int, float] | None:
+        terms: list[tuple[float, Any]] = []
+        if not (_signed_leaves(eq.lhs, 1.0, terms) and _signed_leaves(eq.rhs, -1.0, terms)):
+            return None
+        if len(terms) != 2:
+            return None
+        (sa, a), (sb, b) = terms
+        ia, ib = self.var_of.get(id(a)), self.var_of.get(id(b))
+        if ia is None or ib is None or ia == ib or a.der_of is not None or b.der_of is not None:
+            return None
+        return (ia, ib, -sb / sa)
+
+    def _check_slow(self, slow) -> None:
+        known = {s.element_hash() for s in ca.vertsplit(self.all_sx)}
+        for s in ca.symvar(ca.vertcat(*[r for r, _ in slow])):
             if s.element_hash() not in known:
                 sym = lookup(s)
-                culprit = next(e for e in self.equations if ca.depends_on(e.residual, s))
+                where = next(w for r, w in slow if ca.depends_on(r, s))
                 owner = f" of {type(sym.owner).__name__}" if sym else ""
                 raise EquationError(
-                    f"{culprit.origin}: equation uses {s}{owner}, which is not part of the "
-                    "model (add its component to the model)")
+                    f"{where}: equation uses {s}{owner}, which is not part of the model "
+                    "(add its component to the model)")
 
-    def _mark_aliases(self, sym_index: dict[int, int], variables) -> None:
-        for eq in self.equations:
-            terms = signed_terms(eq.residual)
-            if terms is None or len(terms) != 2:
-                continue
-            (sa, a), (sb, b) = terms
-            ia, ib = sym_index.get(a.element_hash()), sym_index.get(b.element_hash())
-            if ia is None or ib is None or ia == ib:
-                continue
-            if variables[ia].der_of >= 0 or variables[ib].der_of >= 0:
-                continue
-            eq.alias = (ia, ib, -sb / sa)
+
+class _Pairs:
+    """Two-symbol equations ``a + coef*b = 0`` collected for one vectorized lowering."""
+
+    def __init__(self) -> None:
+        self.a: list[Symbol] = []
+        self.b: list[Symbol] = []
+        self.coef: list[float] = []
+        self.origin: list[str] = []
+
+    def add(self, a: Symbol, b: Symbol, coef: float, origin: str) -> None:
+        self.a.append(a)
+        self.b.append(b)
+        self.coef.append(coef)
+        self.origin.append(origin)
+
+
+def _symbol(x: Any) -> Symbol:
+    if isinstance(x, Leaf) and isinstance(x.sym, Symbol):
+        return x.sym
+    sym = lookup(x) if isinstance(x, ca.SX) else None
+    if sym is None:
+        raise ConnectError(f"cannot connect {x!r}: not a signal variable")
+    return sym
+
+
+def _side_shape(side: Any, leaves: list, consts: list) -> Any:
+    if isinstance(side, Number):
+        consts.append(float(side))
+        return "C"
+    if isinstance(side, Expr):
+        return shape_of(side, leaves, consts)
+    raise TypeError(side)
+
+
+def _count_leaves(shape: Any) -> int:
+    if shape == "L":
+        return 1
+    if shape == "C":
+        return 0
+    return sum(_count_leaves(a) for a in shape[1:])
+
+
+def _count_consts(shape: Any) -> int:
+    if shape == "C":
+        return 1
+    if shape == "L":
+        return 0
+    return sum(_count_consts(a) for a in shape[1:])
+
+
+def _signed_leaves(e: Any, sign: float, out: list) -> bool:
+    """Collect ``(sign, symbol)`` of a sum of (negated) leaves; False for anything else."""
+    if isinstance(e, Leaf):
+        out.append((sign, e.sym))
+        return len(out) <= 2
+    if isinstance(e, float) or isinstance(e, Number):
+        return e == 0
+    if isinstance(e, Expr) and e.op in ("+", "-", "neg") and len(out) <= 2:
+        if e.op == "neg":
+            return _signed_leaves(e.args[0], -sign, out)
+        return (_signed_leaves(e.args[0], sign, out)
+                and _signed_leaves(e.args[1], sign if e.op == "+" else -sign, out))
+    return False
+
+
+def _leaf_symbols(e: Any) -> list:
+    leaves: list = []
+    shape_of(e, leaves, [])
+    return leaves
 
 
 def _join(path: str, name: str) -> str:
     return f"{path}.{name}" if path else name
+

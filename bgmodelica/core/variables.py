@@ -2,8 +2,8 @@
 
 A declaration (``Parameter``, ``Variable``, ``Potential``, ``Flow``, ``Input``, ``Output``) is
 written once in a component class body. Each component instance turns every declaration into a
-:class:`Symbol`: a CasADi SX scalar plus the declaration's metadata. Inside ``equations()``,
-``self.R`` *is* the SX scalar, so physics reads as plain algebra.
+:class:`Symbol`: the declaration's metadata plus an expression leaf. Inside ``equations()``,
+``self.R`` *is* that leaf, so physics reads as plain algebra.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from typing import Any
 import casadi as ca
 
 from ..errors import DeclarationError
+from .expr import Leaf
 
 
 class StateSelect(IntEnum):
@@ -129,21 +130,34 @@ class Output(Variable):
 class Symbol:
     """One declared scalar of one component instance.
 
-    Attributes: ``name`` (local), ``decl`` (its :class:`Declaration`), ``sx`` (the SX scalar),
-    ``owner`` (the component or connector instance), and, once ``der`` has been taken, ``der``
-    (the Symbol of its time derivative).
+    Attributes: ``name`` (local), ``decl`` (its :class:`Declaration`), ``owner`` (the component
+    or connector instance), ``leaf`` (the expression node used in equations), ``sx`` (its CasADi
+    SX scalar, created on first use or bound by flattening), and, once ``der`` has been taken,
+    ``der`` (the Symbol of its time derivative).
     """
 
-    __slots__ = ("name", "decl", "sx", "owner", "der", "der_of", "__weakref__")
+    __slots__ = ("name", "decl", "_sx", "owner", "der", "der_of", "leaf", "__weakref__")
 
     def __init__(self, name: str, decl: Declaration, owner: Any, der_of: Symbol | None = None):
         self.name = name
         self.decl = decl
-        self.sx = ca.SX.sym(name)
+        self._sx: ca.SX | None = None
         self.owner = owner
         self.der: Symbol | None = None
         self.der_of = der_of
-        _REGISTRY[self.sx.element_hash()] = self
+        self.leaf = Leaf(self)
+
+    @property
+    def sx(self) -> ca.SX:
+        """The SX scalar of this symbol (created on first use)."""
+        if self._sx is None:
+            self._sx = ca.SX.sym(self.name)
+            _REGISTRY[self._sx.element_hash()] = self
+        return self._sx
+
+    def bind(self, sx: ca.SX) -> None:
+        """Use ``sx`` (an element of a flattening's symbol vector) as this symbol's SX."""
+        self._sx = sx
 
     def derivative(self) -> Symbol:
         """The symbol of this variable's time derivative (created once)."""
@@ -158,6 +172,17 @@ class Symbol:
         return f"Symbol({self.name!r}, {type(self.decl).__name__})"
 
 
+class _Time:
+    """The model time as a leaf symbol."""
+
+    name = "time"
+    decl = None
+
+    def __init__(self) -> None:
+        self.sx = ca.SX.sym("time")
+        self.leaf = Leaf(self)
+
+
 def derivative_unit(unit: str) -> str:
     """Unit of the time derivative of a quantity in ``unit``."""
     if not unit or unit == "1":
@@ -168,8 +193,9 @@ def derivative_unit(unit: str) -> str:
 #: SX node hash -> Symbol, so ``der(x)`` can find the declaration behind an SX scalar.
 _REGISTRY: weakref.WeakValueDictionary[int, Symbol] = weakref.WeakValueDictionary()
 
-#: The model time, shared by all models.
-time = ca.SX.sym("time")
+TIME = _Time()
+#: The model time [s], shared by all models (an expression leaf; ``TIME.sx`` is its SX).
+time = TIME.leaf
 
 
 def lookup(sx: ca.SX) -> Symbol | None:

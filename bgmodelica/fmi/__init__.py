@@ -1,8 +1,31 @@
 """FMU export (FMI 2.0 and 3.0, Model Exchange and Co-Simulation) of compiled models.
 
-The compiler hands an :class:`FmuSpec` (explicit ODE with outputs, as CasADi functions) to
-:func:`export_fmu`, which generates C with CasADi, adds our own FMI runtime (``templates/``),
-compiles it with the system C compiler and zips ``<model_name>.fmu``.
+The compiler hands an :class:`FmuSpec` (explicit ODE with outputs, as CasADi functions; see
+:mod:`bgmodelica.fmi.spec`) to :func:`export_fmu`, which
+
+1. builds dense canonical CasADi functions (model, forward derivative, Jacobian d(xdot)/dx,
+   optional init) and generates their C code (:mod:`~bgmodelica.fmi.codegen`);
+2. lays out the variables and writes ``modelDescription.xml``
+   (:mod:`~bgmodelica.fmi.variables`, :mod:`~bgmodelica.fmi.model_description`,
+   :mod:`~bgmodelica.fmi.units`);
+3. adds our own C runtime (``templates/``: ``bgm_core`` + ``bgm_solver`` + the FMI 2.0 / 3.0
+   wrappers) and the official FMI headers shipped with fmpy (:mod:`~bgmodelica.fmi.csources`);
+4. compiles a shared library with the system C compiler and zips ``<model_name>.fmu`` with the
+   sources included (:mod:`~bgmodelica.fmi.build`).
+
+Co-Simulation solver.  Electromechanical models are stiff (electrical time constants of
+microseconds next to mechanical ones of seconds), so the embedded solver must be L-stable; it
+must also be cheap per communication step, self-contained C and accurate enough that the
+communication step, not the solver, dominates the error.  We use the 5-stage order-4 SDIRK
+method of Hairer & Wanner (gamma = 1/4, L-stable, stiffly accurate) with its embedded order-3
+error estimate.  Compared with a 2-stage Radau IIA (order 3) it needs only one n x n LU
+factorisation per step (all stages share the diagonal coefficient) instead of a 2n x 2n or
+complex system, and order 4 keeps the number of steps low at tolerance 1e-6.  Newton iterations
+use the CasADi-generated Jacobian and a dense LU with partial pivoting; the error estimate is
+filtered through (I - h gamma J)^-1 so stiff components do not cause needless rejections.
+Tunable parameters ``solver.tolerance`` (default: the spec's ``tolerance``, 1e-6; the tighter of
+it and a tolerance passed by the importer is used) and ``solver.max_step`` (default: the
+experiment length) control it; inputs are held over each communication step.
 """
 
 from .build import FmuBuildError

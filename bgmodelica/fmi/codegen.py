@@ -22,6 +22,7 @@ too, from the Jacobian sparsity of the same functions.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -59,6 +60,15 @@ class Dependencies:
     init_states: list[tuple[list[int], list[int], list[int]]]
     init_derivatives: list[tuple[list[int], list[int], list[int]]]
     init_outputs: list[tuple[list[int], list[int], list[int]]]
+
+
+def symbol_prefix(model_name: str) -> str:
+    """C/CasADi symbol prefix for a model: letters first, no repeated or trailing ``_``
+    (CasADi function names must not contain ``__``)."""
+    core = re.sub(r"_+", "_", model_name).strip("_") or "model"
+    if not core[0].isalpha():
+        core = "m" + core
+    return core + "_"
 
 
 def _call(f: ca.Function, args: list[ca.MX]) -> list[ca.MX]:
@@ -113,7 +123,7 @@ def generate_c(funcs: ModelFunctions, out_dir: Path, basename: str, prefix: str)
 def _rows_by_col(sp: ca.Sparsity) -> list[list[int]]:
     """For a Jacobian sparsity (rows = outputs, cols = inputs): dependencies of each row."""
     deps: list[list[int]] = [[] for _ in range(sp.size1())]
-    for r, c in zip(sp.row(), sp.get_col()):
+    for r, c in zip(sp.row(), sp.get_col(), strict=True):
         deps[r].append(c)
     return [sorted(d) for d in deps]
 
@@ -130,12 +140,12 @@ def dependencies(spec: FmuSpec, funcs: ModelFunctions) -> Dependencies:
 
     dxdx, dxdu, dxdp = (pattern(ode, 0, i, nx) for i in (1, 2, 3))
     dydx, dydu, dydp = (pattern(ode, 1, i, ny) for i in (1, 2, 3))
-    derivatives = list(zip(dxdx, dxdu))
-    outputs = list(zip(dydx, dydu))
+    derivatives = list(zip(dxdx, dxdu, strict=True))
+    outputs = list(zip(dydx, dydu, strict=True))
     if funcs.init is None:
         init_states: list[tuple[list[int], list[int], list[int]]] = []
-        init_derivatives = list(zip(dxdx, dxdu, dxdp))
-        init_outputs = list(zip(dydx, dydu, dydp))
+        init_derivatives = list(zip(dxdx, dxdu, dxdp, strict=True))
+        init_outputs = list(zip(dydx, dydu, dydp, strict=True))
     else:
         # total dependencies of (x0, xdot0, y0) on (u, p) through init
         t = ca.MX.sym("t")
@@ -149,6 +159,6 @@ def dependencies(spec: FmuSpec, funcs: ModelFunctions) -> Dependencies:
         for oind, n in ((0, nx), (1, nx), (2, ny)):
             du_ = pattern(total, oind, 1, n)
             dp_ = pattern(total, oind, 2, n)
-            trip.append([(list(empty), a, b) for a, b in zip(du_, dp_)])
+            trip.append([(list(empty), a, b) for a, b in zip(du_, dp_, strict=True)])
         init_states, init_derivatives, init_outputs = trip
     return Dependencies(derivatives, outputs, init_states, init_derivatives, init_outputs)

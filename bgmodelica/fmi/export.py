@@ -46,7 +46,7 @@ def export_fmu(spec: FmuSpec, out_dir: str | Path, fmi_version: int = 2,
     spec.validate()
     interfaces = FMU_TYPES[fmu_type]
     ident = spec.model_name
-    prefix = f"{ident}_"
+    prefix = codegen.symbol_prefix(ident)
     funcs = codegen.build_functions(spec, prefix)
     deps = codegen.dependencies(spec, funcs)
     table = build_table(spec, with_solver="cs" in interfaces)
@@ -55,7 +55,7 @@ def export_fmu(spec: FmuSpec, out_dir: str | Path, fmi_version: int = 2,
         root = Path(tmp) / "fmu"
         src = root / "sources"
         src.mkdir(parents=True)
-        model_base = f"{ident}_model"
+        model_base = f"{prefix}model"
         codegen.generate_c(funcs, src, model_base, prefix)
         write_runtime(fmi_version, src)
         token = instantiation_token(

@@ -41,7 +41,7 @@ def _num(value: float) -> str:
 def instantiation_token(*parts: str) -> str:
     """A GUID-formatted token derived from a hash of ``parts``."""
     h = hashlib.sha256("\x00".join(parts).encode("utf-8")).hexdigest()
-    return "{%s-%s-%s-%s-%s}" % (h[:8], h[8:12], h[12:16], h[16:20], h[20:32])
+    return "{" + "-".join((h[:8], h[8:12], h[12:16], h[16:20], h[20:32])) + "}"
 
 
 def _units(table: VariableTable, parent: ET.Element) -> None:

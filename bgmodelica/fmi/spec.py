@@ -24,7 +24,8 @@ Variables:
 * ``min``/``max`` (optional) bound the values the FMU accepts for inputs, parameters and state
   start values (outside: an error status);
 * ``nominal`` (optional, states only) scales the absolute tolerance of integrators and is returned
-  by ``GetNominalsOfContinuousStates``.
+  by ``GetNominalsOfContinuousStates``;
+* the ``start`` of outputs and locals is not exported (they are calculated).
 
 All parameters are ``causality="parameter"``, ``variability="tunable"``: settable before and
 during initialization, in Event Mode (Model Exchange) and between communication steps

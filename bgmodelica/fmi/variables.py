@@ -24,7 +24,6 @@ solver (CS only)       ``solver.tolerance``,           parameter    tunable     
 from __future__ import annotations
 
 import math
-
 from dataclasses import dataclass
 
 from .spec import FmuSpec, ScalarVariable

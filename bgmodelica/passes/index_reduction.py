@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 import casadi as ca
 
 from ..core.flatmodel import FlatEquation, FlatModel, FlatVariable
-from ..core.variables import Variable, derivative_unit, time
+from ..core.variables import TIME, Variable, derivative_unit
 from ..errors import EquationError, UnbalancedModelError
 from ..structure import EquationGraph, dummy_derivatives, pantelides
 from ..structure.errors import StructuralError, StructurallySingular
@@ -86,7 +86,7 @@ def reduce_index(model: FlatModel | ReducedModel,
                                 f"{', '.join(missing)} has no derivative")
         _check_inputs(model, src)
         res = time_derivative(src.residual, [variables[j].sx for j in vs],
-                              [variables[variables[j].der].sx for j in vs], time)
+                              [variables[variables[j].der].sx for j in vs], TIME.sx)
         equations.append(FlatEquation(res, f"d/dt of {src.origin}"))
         rows.append(incidence([res], [variables[j].sx for j in range(len(variables))])[0]
                     if res.numel() else [])

@@ -329,6 +329,11 @@ fmi3Status fmi3ExitConfigurationMode(fmi3Instance instance) {
                             "the model has no structural parameters");
 }
 
+/* the clock arrays are never touched: there are no clocks */
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#endif
 #define BGM_NO_CLOCK(NAME, ...)                                                     \
     fmi3Status fmi3##NAME(fmi3Instance instance,                                    \
                           const fmi3ValueReference valueReferences[],               \
@@ -347,6 +352,9 @@ BGM_NO_CLOCK(SetIntervalDecimal, const fmi3Float64 intervals[])
 BGM_NO_CLOCK(SetIntervalFraction, const fmi3UInt64 counters[], const fmi3UInt64 resolutions[])
 BGM_NO_CLOCK(SetShiftDecimal, const fmi3Float64 shifts[])
 BGM_NO_CLOCK(SetShiftFraction, const fmi3UInt64 counters[], const fmi3UInt64 resolutions[])
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
 
 fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clockReference,
                                       fmi3Float64 activationTime) {

@@ -1,0 +1,53 @@
+"""Bond graphs as first-class models.
+
+Elements (:mod:`.elements`): ``Se, Sf, R, C, I, TF, GY, MTF, MGY, ZeroJunction (J0),
+OneJunction (J1), De, Df, Dq`` with :class:`PowerPort` s; :class:`BondGraph` components with
+``bond(a, b)`` and ``expose(name, target)``; the pure :class:`Graph` (``graph_of``);
+causality (SCAP, BGI/BGD views), structural controllability/observability, causal equations
+(text, LaTeX), ``analyze(model) -> BondGraphReport`` and ``draw(model, path)``.
+"""
+
+from .causality import BGD, BGI, Causality, Conflict, assign_causality, signal_graph
+from .elements import (
+    GY,
+    MGY,
+    MTF,
+    TF,
+    BGElement,
+    C,
+    De,
+    Df,
+    Dq,
+    I,
+    J0,
+    J1,
+    OneJunction,
+    PowerPort,
+    R,
+    Se,
+    Sf,
+    ZeroJunction,
+    bond_flow,
+    orientation,
+)
+from .equations import CausalEquations, causal_equations
+from .errors import (
+    BondError,
+    BondGraphError,
+    CausalConflictError,
+    JunctionError,
+    ModulusError,
+)
+from .graph import Bond, Graph, Node
+from .model import BondGraph, graph_of
+from .structural import StructuralProperty, controllability, observability
+
+__all__ = [
+    "PowerPort", "BGElement", "Se", "Sf", "R", "C", "I", "TF", "GY", "MTF", "MGY",
+    "ZeroJunction", "OneJunction", "J0", "J1", "De", "Df", "Dq", "orientation", "bond_flow",
+    "BondGraph", "graph_of", "Graph", "Node", "Bond",
+    "assign_causality", "Causality", "Conflict", "BGI", "BGD", "signal_graph",
+    "controllability", "observability", "StructuralProperty",
+    "causal_equations", "CausalEquations",
+    "BondGraphError", "BondError", "JunctionError", "ModulusError", "CausalConflictError",
+]

@@ -1,0 +1,491 @@
+"""Causality assignment: the Sequential Causality Assignment Procedure (SCAP) of Karnopp,
+Margolis and Rosenberg, on a pure :class:`~bgmodelica.bondgraph.graph.Graph`.
+
+Causality of a bond is recorded as the end that *receives the effort* (where the causal stroke
+is drawn). Constraints:
+
+* Se gives effort (stroke away from it), Sf gives flow (stroke at it); De receives effort
+  (an ideal effort detector draws no flow), Df receives flow (imposes no effort).
+* C: integral causality = flow in, effort out (stroke away); derivative = stroke at C.
+  I: integral causality = effort in, flow out (stroke at I); derivative = stroke away.
+* R, X (adapters to other domains): free.
+* 0-junction: exactly one bond imposes the (common) effort on the junction.
+  1-junction: exactly one bond imposes the (common) flow on the junction.
+* TF/MTF: effort passes through (exactly one stroke at the element);
+  GY/MGY: both strokes at the element or both away.
+
+SCAP: (1) fixed-causality elements (sources, detectors), propagate; (2) storage elements one by
+one (higher ``priority`` first, then declaration order) in preferred causality (integral for
+the BGI, derivative for the BGD), propagate; an element whose bond was already fixed by an
+earlier propagation is *forced* into that causality; (3) free elements (R, X) in resistance
+causality, propagate; (4) any bond still open (a loop of the junction structure) arbitrarily.
+Each choice is tentative: if its propagation runs into a contradiction it is undone and the
+alternative tried; if both fail, a :class:`Conflict` is recorded.
+
+After assignment the causal graph is turned into a signal-flow graph whose strongly connected
+algebraic parts are the zero-order causal paths (algebraic loops).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+
+from .graph import DETECTORS, JUNCTIONS, SOURCES, STORAGE, TWO_PORTS, Bond, Graph, Node
+
+BGI = "BGI"
+BGD = "BGD"
+
+
+@dataclass
+class Conflict:
+    """A causal contradiction: ``element`` could not get the causality it requires because of
+    ``at`` (a junction or two-port whose constraint broke)."""
+
+    element: str
+    at: str
+    message: str
+
+    def to_dict(self) -> dict:
+        return {"element": self.element, "at": self.at, "message": self.message}
+
+
+@dataclass
+class Causality:
+    """Result of SCAP on a graph.
+
+    effort_to: bond number -> the node that receives the effort (stroke end).
+    storage: storage element -> "integral" / "derivative".
+    forced: storage elements that could not get the view's preferred causality (in the BGI:
+    those forced into derivative causality by sources or other storage elements).
+    resistors: R / X element -> "resistance" (flow in) / "conductance" (effort in).
+    arbitrary: elements or bonds ("bond 7") that needed an arbitrary choice.
+    conflicts: unresolvable contradictions. loops: zero-order causal paths, each a dict with
+    the bonds and elements on it.
+    """
+
+    graph: Graph
+    view: str
+    effort_to: dict[int, str]
+    storage: dict[str, str] = field(default_factory=dict)
+    forced: list[str] = field(default_factory=list)
+    resistors: dict[str, str] = field(default_factory=dict)
+    arbitrary: list[str] = field(default_factory=list)
+    conflicts: list[Conflict] = field(default_factory=list)
+    loops: list[dict] = field(default_factory=list)
+
+    @property
+    def integral(self) -> list[str]:
+        return [n for n, c in self.storage.items() if c == "integral"]
+
+    @property
+    def derivative(self) -> list[str]:
+        return [n for n, c in self.storage.items() if c == "derivative"]
+
+    def receives_effort(self, bond: Bond, node: str) -> bool:
+        return self.effort_to.get(bond.number) == node
+
+    def to_dict(self) -> dict:
+        return {
+            "view": self.view,
+            "bonds": [{"bond": b.number, "from": b.tail, "to": b.head,
+                       "stroke_at": self.effort_to.get(b.number)} for b in self.graph.bonds],
+            "integral": self.integral, "derivative": self.derivative, "forced": self.forced,
+            "resistors": dict(self.resistors), "arbitrary": list(self.arbitrary),
+            "conflicts": [c.to_dict() for c in self.conflicts],
+            "zero_order_causal_paths": self.loops,
+        }
+
+
+class _Contradiction(Exception):
+    def __init__(self, at: str, message: str) -> None:
+        super().__init__(message)
+        self.at = at
+        self.message = message
+
+
+def _wanted(node: Node, choice: str) -> str:
+    """Which end receives the effort for a one-port ``node`` in ``choice`` causality:
+    "self" or "other"."""
+    k = node.kind
+    if k == "Se" or (k == "Df"):
+        return "other"
+    if k == "Sf" or k == "De":
+        return "self"
+    if k == "C":
+        return "other" if choice == "integral" else "self"
+    if k == "I":
+        return "self" if choice == "integral" else "other"
+    # R, X, and dualized sources/detectors: "resistance" = flow in, effort out
+    return "other" if choice in ("resistance", "effort-out") else "self"
+
+
+class _Assigner:
+    def __init__(self, graph: Graph) -> None:
+        self.g = graph
+        self.inc = graph.incidence()
+        self.eto: dict[int, str] = {}
+
+    def set(self, bond: Bond, to: str, queue: deque) -> None:
+        cur = self.eto.get(bond.number)
+        if cur is not None:
+            if cur != to:
+                raise _Contradiction(to, f"bond {bond.number} ({bond.tail} -> {bond.head}) "
+                                     f"would need its effort imposed on both ends")
+            return
+        self.eto[bond.number] = to
+        queue.append(bond.tail)
+        queue.append(bond.head)
+
+    def one_port(self, node: Node, where: str) -> None:
+        """Assign ``node``'s single bond so that ``where`` ("self"/"other") gets the effort."""
+        bond = self.inc[node.name][0]
+        to = node.name if where == "self" else bond.other(node.name)
+        queue: deque = deque()
+        self.set(bond, to, queue)
+        self.propagate(queue)
+
+    def propagate(self, queue: deque) -> None:
+        while queue:
+            name = queue.popleft()
+            for bond, to in self.forced(self.g.nodes[name]):
+                self.set(bond, to, queue)
+
+    def forced(self, node: Node) -> list[tuple[Bond, str]]:
+        bonds = self.inc[node.name]
+        name = node.name
+        if node.kind in JUNCTIONS:
+            # "strong" bond: imposes the junction's common variable on it.
+            # 0: effort into the junction; 1: effort out of the junction (flow in).
+            if node.kind == "0":
+                def is_strong(b):
+                    return self.eto.get(b.number) == name
+            else:
+                def is_strong(b):
+                    return b.number in self.eto and self.eto[b.number] != name
+            strong = [b for b in bonds if is_strong(b)]
+            free = [b for b in bonds if b.number not in self.eto]
+            what = "effort" if node.kind == "0" else "flow"
+            if len(strong) > 1:
+                raise _Contradiction(name, f"{node.kind}-junction {name}: bonds "
+                                     f"{', '.join(str(b.number) for b in strong)} all impose "
+                                     f"its common {what}")
+            weak_to = (lambda b: b.other(name)) if node.kind == "0" else (lambda b: name)
+            strong_to = (lambda b: name) if node.kind == "0" else (lambda b: b.other(name))
+            if strong:
+                return [(b, weak_to(b)) for b in free]
+            if len(free) == 1:
+                return [(free[0], strong_to(free[0]))]
+            if not free:
+                raise _Contradiction(name, f"{node.kind}-junction {name}: no bond imposes its "
+                                     f"common {what}")
+            return []
+        if node.kind in TWO_PORTS and len(bonds) == 2:
+            a, b = bonds
+            out = []
+            for x, y in ((a, b), (b, a)):
+                if x.number in self.eto:
+                    x_in = self.eto[x.number] == name
+                    y_in = (not x_in) if node.kind in ("TF", "MTF") else x_in
+                    want = name if y_in else y.other(name)
+                    if y.number in self.eto:
+                        if self.eto[y.number] != want:
+                            rule = ("an effort in and an effort out" if node.kind in
+                                    ("TF", "MTF") else "two efforts in or two flows in")
+                            raise _Contradiction(name, f"{node.title} {name} needs {rule}")
+                    else:
+                        out.append((y, want))
+            return out
+        return []
+
+    def attempt(self, action) -> _Contradiction | None:
+        saved = dict(self.eto)
+        try:
+            action()
+        except _Contradiction as err:
+            self.eto = saved
+            return err
+        return None
+
+
+def assign_causality(graph: Graph, view: str = BGI, dualize: frozenset[str] | set[str] = (),
+                     check: bool = True) -> Causality:
+    """Run SCAP on ``graph``.
+
+    view: ``"BGI"`` (storage prefers integral causality) or ``"BGD"`` (derivative).
+    dualize: element kinds ("Se", "Sf", "De", "Df") whose causality is left free, as for the
+    rank conditions of structural controllability (sources) and observability (detectors).
+    check: validate the graph first (junction bond counts, two-port directions).
+    """
+    if check:
+        graph.validate()
+    a = _Assigner(graph)
+    res = Causality(graph, view, a.eto)
+    order = list(graph.nodes.values())
+    inc = a.inc
+    fixed = [n for n in order if (n.kind in SOURCES | DETECTORS) and n.kind not in dualize]
+    free = [n for n in order if n.kind in ("R", "X") or (n.kind in dualize)]
+    storage = sorted((n for n in order if n.kind in STORAGE),
+                     key=lambda n: -n.priority)          # stable: declaration order kept
+    preferred = "integral" if view == BGI else "derivative"
+    other = "derivative" if preferred == "integral" else "integral"
+
+    def assigned(n: Node) -> bool:
+        return bool(inc[n.name]) and inc[n.name][0].number in a.eto
+
+    # (1) fixed causality
+    for n in fixed:
+        if not inc[n.name]:
+            continue
+        err = a.attempt(lambda n=n: a.one_port(n, _wanted(n, "")))
+        if err is not None:
+            res.conflicts.append(Conflict(n.name, err.at, err.message))
+    # (2) storage
+    for n in storage:
+        if not inc[n.name]:
+            continue
+        if assigned(n):
+            continue
+        err = a.attempt(lambda n=n: a.one_port(n, _wanted(n, preferred)))
+        if err is not None:
+            err2 = a.attempt(lambda n=n: a.one_port(n, _wanted(n, other)))
+            if err2 is not None:
+                res.conflicts.append(Conflict(n.name, err2.at, err2.message))
+    # (3) free elements
+    for n in free:
+        if not inc[n.name] or assigned(n):
+            continue
+        res.arbitrary.append(n.name)
+        err = a.attempt(lambda n=n: a.one_port(n, _wanted(n, "resistance")))
+        if err is not None:
+            err2 = a.attempt(lambda n=n: a.one_port(n, _wanted(n, "conductance")))
+            if err2 is not None:
+                res.conflicts.append(Conflict(n.name, err2.at, err2.message))
+    # (4) open bonds of the junction structure
+    for b in graph.bonds:
+        if b.number in a.eto:
+            continue
+        res.arbitrary.append(f"bond {b.number}")
+        for to in (b.head, b.tail):
+            def act(b=b, to=to):
+                q: deque = deque()
+                a.set(b, to, q)
+                a.propagate(q)
+            if a.attempt(act) is None:
+                break
+        else:
+            res.conflicts.append(Conflict(b.head, b.head, f"bond {b.number} cannot be given "
+                                          "a consistent causality"))
+    res.effort_to = a.eto
+    # read back the causality of one-ports
+    for n in order:
+        bonds = inc[n.name]
+        if not bonds or bonds[0].number not in a.eto:
+            continue
+        into = a.eto[bonds[0].number] == n.name
+        if n.kind in STORAGE:
+            integral = into if n.kind == "I" else not into
+            res.storage[n.name] = "integral" if integral else "derivative"
+        elif n.kind in ("R", "X") or n.kind in dualize:
+            res.resistors[n.name] = "conductance" if into else "resistance"
+        elif n.kind in SOURCES | DETECTORS:
+            want = _wanted(n, "")
+            if (want == "self") != into and not any(c.element == n.name
+                                                    for c in res.conflicts):
+                res.conflicts.append(Conflict(n.name, bonds[0].other(n.name),
+                                              f"{n.title} {n.name} cannot impose its "
+                                              "causality"))
+    # forced: storage elements that could not get the preferred causality
+    res.forced = [n.name for n in storage if res.storage.get(n.name, preferred) != preferred]
+    res.loops = zero_order_paths(res)
+    return res
+
+
+# -- signal-flow graph ---------------------------------------------------------------------
+@dataclass
+class SignalGraph:
+    """Causal signal-flow graph: nodes ("e", bond), ("f", bond), ("x", storage),
+    ("u", source), ("y", detector), ("ext", adapter); edges (src, dst, algebraic?, element)."""
+
+    edges: list[tuple[tuple, tuple, bool, str]]
+
+    def successors(self, algebraic_only: bool = False) -> dict[tuple, list[tuple]]:
+        out: dict[tuple, list[tuple]] = {}
+        for s, d, alg, _ in self.edges:
+            if alg or not algebraic_only:
+                out.setdefault(s, []).append(d)
+                out.setdefault(d, [])
+        return out
+
+
+def signal_graph(c: Causality) -> SignalGraph:
+    """Signal-flow graph of a causal bond graph (see :class:`SignalGraph`)."""
+    g, eto = c.graph, c.effort_to
+    inc = g.incidence()
+    edges: list[tuple[tuple, tuple, bool, str]] = []
+
+    def add(s, d, alg, el):
+        edges.append((s, d, alg, el))
+
+    for n in g.nodes.values():
+        bonds = [b for b in inc[n.name] if b.number in eto]
+        name = n.name
+        if n.kind in JUNCTIONS:
+            if n.kind == "0":
+                strong = [b for b in bonds if eto[b.number] == name]
+            else:
+                strong = [b for b in bonds if eto[b.number] != name]
+            if len(strong) != 1:
+                continue
+            s = strong[0].number
+            for b in bonds:
+                if b.number == s:
+                    continue
+                if n.kind == "0":
+                    add(("e", s), ("e", b.number), True, name)
+                    add(("f", b.number), ("f", s), True, name)
+                else:
+                    add(("f", s), ("f", b.number), True, name)
+                    add(("e", b.number), ("e", s), True, name)
+            continue
+        if n.kind in TWO_PORTS:
+            if len(bonds) != 2:
+                continue
+            a, b = bonds
+            a_in, b_in = eto[a.number] == name, eto[b.number] == name
+            if n.kind in ("TF", "MTF"):
+                if a_in == b_in:
+                    continue
+                x, y = (a, b) if a_in else (b, a)          # effort in at x, out at y
+                add(("e", x.number), ("e", y.number), True, name)
+                add(("f", y.number), ("f", x.number), True, name)
+            else:
+                if a_in != b_in:
+                    continue
+                v_in, v_out = ("e", "f") if a_in else ("f", "e")
+                add((v_in, a.number), (v_out, b.number), True, name)
+                add((v_in, b.number), (v_out, a.number), True, name)
+            continue
+        if not bonds:
+            continue
+        k = bonds[0].number
+        into = eto[k] == name
+        if n.kind == "Se" and not into and not n.zero:
+            add(("u", name), ("e", k), True, name)
+        elif n.kind == "Sf" and into and not n.zero:
+            add(("u", name), ("f", k), True, name)
+        elif n.kind == "De":
+            add(("e", k), ("y", name), True, name)
+        elif n.kind == "Df":
+            add(("f", k), ("y", name), True, name)
+        elif n.kind == "R":
+            if into:
+                add(("e", k), ("f", k), True, name)
+            else:
+                add(("f", k), ("e", k), True, name)
+        elif n.kind in STORAGE:
+            integral = c.storage.get(name) == "integral"
+            v_in = "e" if into else "f"
+            v_out = "f" if into else "e"
+            add((v_in, k), ("x", name), not integral, name)
+            add(("x", name), (v_out, k), integral, name)
+        elif n.kind == "X":
+            v_in = "e" if into else "f"
+            v_out = "f" if into else "e"
+            add((v_in, k), ("ext", name), False, name)
+            add(("ext", name), (v_out, k), False, name)
+    return SignalGraph(edges)
+
+
+def _sccs(succ: dict[tuple, list[tuple]]) -> list[list[tuple]]:
+    """Tarjan's strongly connected components (iterative)."""
+    index: dict[tuple, int] = {}
+    low: dict[tuple, int] = {}
+    on: set[tuple] = set()
+    stack: list[tuple] = []
+    out: list[list[tuple]] = []
+    counter = 0
+    for root in succ:
+        if root in index:
+            continue
+        work = [(root, iter(succ[root]))]
+        index[root] = low[root] = counter
+        counter += 1
+        stack.append(root)
+        on.add(root)
+        while work:
+            v, it = work[-1]
+            advanced = False
+            for w in it:
+                if w not in index:
+                    index[w] = low[w] = counter
+                    counter += 1
+                    stack.append(w)
+                    on.add(w)
+                    work.append((w, iter(succ[w])))
+                    advanced = True
+                    break
+                if w in on:
+                    low[v] = min(low[v], index[w])
+            if advanced:
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[v])
+            if low[v] == index[v]:
+                comp = []
+                while True:
+                    w = stack.pop()
+                    on.discard(w)
+                    comp.append(w)
+                    if w == v:
+                        break
+                out.append(comp)
+    return out
+
+
+def zero_order_paths(c: Causality) -> list[dict]:
+    """Algebraic loops of the causal graph: strongly connected sets of effort/flow signals
+    linked by algebraic (non-integrating) relations. Each: ``{"bonds": [...], "elements":
+    [...], "resistors": [...]}``."""
+    sg = signal_graph(c)
+    comps = [comp for comp in _sccs(sg.successors(algebraic_only=True)) if len(comp) > 1]
+    out = []
+    for comp in comps:
+        members = set(comp)
+        bonds = sorted({v[1] for v in comp if v[0] in ("e", "f")})
+        elements = []
+        for s, d, alg, el in sg.edges:
+            if alg and s in members and d in members and el not in elements:
+                elements.append(el)
+        resistors = [e for e in elements if c.graph.nodes[e].kind == "R"]
+        out.append({"bonds": bonds, "elements": elements, "resistors": resistors})
+    return out
+
+
+def reach(sg: SignalGraph, starts: list[tuple], reverse: bool = False) -> dict[tuple, tuple]:
+    """Breadth-first reachability over every edge; returns node -> predecessor."""
+    succ: dict[tuple, list[tuple]] = {}
+    for s, d, _, _ in sg.edges:
+        if reverse:
+            s, d = d, s
+        succ.setdefault(s, []).append(d)
+    parent: dict[tuple, tuple] = {s: s for s in starts}
+    queue = deque(starts)
+    while queue:
+        v = queue.popleft()
+        for w in succ.get(v, ()):
+            if w not in parent:
+                parent[w] = v
+                queue.append(w)
+    return parent
+
+
+def path_to(parent: dict[tuple, tuple], target: tuple) -> list[tuple]:
+    """Node sequence from a BFS start to ``target`` (empty if unreachable)."""
+    if target not in parent:
+        return []
+    out = [target]
+    while parent[out[-1]] != out[-1]:
+        out.append(parent[out[-1]])
+    return out[::-1]

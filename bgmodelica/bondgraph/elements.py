@@ -1,0 +1,589 @@
+"""Bond-graph elements as acausal components.
+
+Power ports and bonds
+---------------------
+A :class:`PowerPort` is a connector with effort ``e`` (a potential) and flow ``f`` (a flow,
+counted positive *into* the element that owns the port, as every connector flow). A bond
+``tail -> head`` is a connection of two ports: ``e`` equal, ``f_tail + f_head = 0``. The bond's
+own flow (along its half-arrow) is therefore ``+head.f = -tail.f``: each port knows its
+``orientation`` (+1 if the half-arrow points into its element, -1 if out) and the element laws
+use the *bond flow* ``orientation * port.f``. Power into an element through a port is always
+``e * port.f``.
+
+Element laws (in bond variables, the half-arrow convention of the paper, Table III)
+-----------------------------------------------------------------------------------
+Se ``e = E``; Sf ``f = F``; R ``e = R f``; C ``dq/dt = f, C e = q``; I ``dp/dt = e,
+I f = p``; TF/MTF ``e1 = m e2, f2 = m f1``; GY/MGY ``e1 = r f2, e2 = r f1``; 0-junction: common
+effort, flows (signed by half-arrow) sum to 0; 1-junction: common flow, efforts sum to 0;
+De ``y = e, f = 0``; Df ``y = f, e = 0``; Dq ``dy/dt = f, e = 0`` (displacement detector).
+
+Values and moduli may be numbers, parameter expressions, SX expressions of model variables,
+callables receiving the enclosing :class:`~bgmodelica.bondgraph.model.BondGraph`
+(``lambda m: m.l1*cos(m.q1)``) or strings evaluated in its namespace (``"l1*cos(q1)"``).
+Nonlinear laws: ``R(law=lambda e, f: e == 2*f**3)``, ``C(law=lambda e, q: ...)``,
+``I(law=lambda f, p: ...)`` (a third argument, if declared, receives the bond graph).
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+from typing import Any, ClassVar
+
+import casadi as ca
+
+from ..core import expressions as _expressions
+from ..core.component import Component, Connector
+from ..core.variables import (
+    Declaration,
+    Flow,
+    Input,
+    Output,
+    Parameter,
+    Potential,
+    Symbol,
+    Variable,
+    lookup,
+)
+from ..core.variables import time as _time
+
+try:                                    # the equation-language layer, when present
+    from ..core.expr import Equation as _Equation
+    from ..core.expr import Expr as _Expr
+except ImportError:  # pragma: no cover - older core
+    _Equation = None
+    _Expr = None
+from .errors import BondError, JunctionError, ModulusError
+
+__all__ = ["PowerPort", "BGElement", "Se", "Sf", "R", "C", "I", "TF", "GY", "MTF", "MGY",
+           "ZeroJunction", "OneJunction", "J0", "J1", "De", "Df", "Dq", "orientation",
+           "bond_flow"]
+
+
+class PowerPort(Connector):
+    """Bond-graph power port: effort ``e`` and flow ``f`` (positive into the element)."""
+
+    e = Potential(description="Effort")
+    f = Flow(description="Flow into the element that owns the port")
+
+    def __init__(self, name: str | None = None, **modifiers: Any) -> None:
+        for attr in ("_sign", "_peer", "_inner", "_outer", "_owner"):
+            object.__setattr__(self, attr, None)
+        object.__setattr__(self, "_default", 1)
+        super().__init__(name, **modifiers)
+
+    @property
+    def orientation(self) -> int:
+        return orientation(self)
+
+    @property
+    def bonded(self) -> bool:
+        return self._peer is not None or self._outer is not None
+
+
+def orientation(port: PowerPort) -> int:
+    """+1 if the half-arrow of the bond on ``port`` points into its element, -1 if out. For a
+    port exposed by a subsystem the outer bond decides; an unbonded port has its default."""
+    p = port
+    for _ in range(1000):
+        if p._sign is not None:
+            return p._sign
+        if p._outer is None:
+            return p._default
+        p = p._outer
+    raise BondError(f"port {port.name}: exposure chain loops")  # pragma: no cover
+
+
+def bond_flow(port: PowerPort) -> Any:
+    """The bond's flow along its half-arrow, seen from ``port``."""
+    return port.f if orientation(port) > 0 else -port.f
+
+
+_MATH: dict[str, Any] = {name: getattr(_expressions, name) for name in (
+    "sin", "cos", "tan", "exp", "log", "sqrt", "atan2", "tanh", "fabs", "sign")}
+_MATH.update(abs=_expressions.fabs, pi=math.pi, time=_time)
+_NUMBER = (int, float)
+
+
+def is_expression(x: Any) -> bool:
+    """A number, an equation-language expression or a CasADi SX scalar."""
+    if isinstance(x, _NUMBER) and not isinstance(x, bool):
+        return True
+    if isinstance(x, (ca.SX, ca.MX)):
+        return x.numel() == 1
+    return _Expr is not None and isinstance(x, _Expr)
+
+
+def is_equation(x: Any) -> bool:
+    """Whether ``x`` is an equation ``lhs == rhs`` (equation object or SX ``==`` node)."""
+    if _Equation is not None and isinstance(x, _Equation):
+        return True
+    return isinstance(x, ca.SX) and x.numel() == 1 and x.is_op(ca.OP_EQ)
+
+
+def symbol_name(x: Any) -> str | None:
+    """Name of the declared symbol behind a leaf / SX symbol, else None."""
+    sym = getattr(x, "sym", None)
+    if sym is not None and hasattr(sym, "decl"):
+        return sym.name
+    if isinstance(x, ca.SX) and x.numel() == 1 and x.is_symbolic():
+        found = lookup(x)
+        return found.name if found is not None else None
+    return None
+
+
+def element_path(elem: Any) -> str:
+    """Dotted path of an element through the bond graphs that own it."""
+    parts = []
+    e = elem
+    while e is not None:
+        if e.name:
+            parts.append(e.name)
+        e = getattr(e, "_bg_owner", None)
+    return ".".join(reversed(parts)) or type(elem).__name__
+
+
+class _Namespace(dict):
+    """Names visible to a string expression: the owning bond graph's parameters, variables and
+    elements, then those of the enclosing bond graphs, then math functions."""
+
+    def __init__(self, owner: Any) -> None:
+        super().__init__()
+        scopes = []
+        o = owner
+        while o is not None:
+            scopes.append(o)
+            o = getattr(o, "_bg_owner", None)
+        for scope in reversed(scopes):          # inner scopes win
+            for k in scope._symbols:
+                self[k] = getattr(scope, k)
+            for k, child in scope._children.items():
+                self[k] = child
+
+
+def resolve(expr: Any, elem: BGElement, what: str) -> Any:
+    """Turn a value/modulus given as number, expression, callable or string into a scalar
+    expression of the model."""
+    owner = getattr(elem, "_bg_owner", None)
+    where = f"{elem.kind} {element_path(elem)}"
+    if isinstance(expr, _NUMBER):
+        return float(expr)
+    if isinstance(expr, str):
+        if owner is None:
+            raise ModulusError(f"{where}: the {what} {expr!r} is a string but the element is not "
+                               "part of a bond graph", element_path(elem))
+        ns = _Namespace(owner)
+        try:
+            value = eval(expr, {"__builtins__": {}, **_MATH}, ns)  # noqa: S307
+        except NameError as err:
+            names = sorted(k for k in ns if not k.startswith("_"))
+            raise ModulusError(f"{where}: the {what} {expr!r} uses an unknown name ({err}); "
+                               f"known names: {', '.join(names)}", element_path(elem)) from None
+        except AttributeError as err:
+            raise ModulusError(f"{where}: the {what} {expr!r} uses an unknown variable ({err})",
+                               element_path(elem)) from None
+        except SyntaxError as err:
+            raise ModulusError(f"{where}: the {what} {expr!r} is not an expression ({err.msg})",
+                               element_path(elem)) from None
+        return _scalar(value, where, what, elem)
+    if callable(expr) and not is_expression(expr):
+        try:
+            value = expr(owner if owner is not None else elem)
+        except (AttributeError, NameError, KeyError) as err:
+            raise ModulusError(f"{where}: the {what} function refers to an unknown variable "
+                               f"({err})", element_path(elem)) from None
+        return _scalar(value, where, what, elem)
+    return _scalar(expr, where, what, elem)
+
+
+def _scalar(value: Any, where: str, what: str, elem: Any) -> Any:
+    if isinstance(value, (Component, Connector)):
+        raise ModulusError(f"{where}: the {what} is the component {value.name!r}, not an "
+                           "expression (use one of its variables)", element_path(elem))
+    if not is_expression(value):
+        raise ModulusError(f"{where}: the {what} {value!r} is not a scalar number or "
+                           "expression", element_path(elem))
+    return float(value) if isinstance(value, _NUMBER) else value
+
+
+def _law(law: Any, args: list[Any], elem: BGElement) -> list[Any]:
+    try:
+        n = len(inspect.signature(law).parameters)
+    except (TypeError, ValueError):
+        n = len(args)
+    call = list(args) + [getattr(elem, "_bg_owner", None)]
+    try:
+        eq = law(*call[: max(n, len(args))])
+    except (AttributeError, NameError, KeyError) as err:
+        raise ModulusError(f"{elem.kind} {element_path(elem)}: the constitutive law refers to an "
+                           f"unknown variable ({err})", element_path(elem)) from None
+    eqs = eq if isinstance(eq, (list, tuple)) else [eq]
+    for x in eqs:
+        if not is_equation(x):
+            raise ModulusError(f"{elem.kind} {element_path(elem)}: the constitutive law must "
+                               f"return an equation 'lhs == rhs', got {x!r}",
+                               element_path(elem))
+    return list(eqs)
+
+
+def declare(elem: Any, name: str, decl: Declaration) -> Any:
+    """Add a declaration to one instance (a signal input created on demand)."""
+    sym = Symbol(name, decl, elem)
+    elem._symbols[name] = sym
+    leaf = getattr(sym, "leaf", None)
+    value = leaf if leaf is not None else sym.sx
+    object.__setattr__(elem, name, value)
+    return value
+
+
+class BGElement(Component):
+    """Base of bond-graph elements. Keyword arguments of every element: ``label`` (drawing
+    text after the colon and symbol in causal equations), ``pos`` (drawing position hint),
+    ``priority`` (storage elements: higher gets integral causality first)."""
+
+    kind: ClassVar[str] = ""
+    _main: ClassVar[str | None] = None          # parameter whose name makes the default label
+    _port_defaults: ClassVar[dict[str, int]] = {"port": 1}
+
+    def __init__(self, name: str | None = None, *, label: str | None = None,
+                 pos: tuple[float, float] | None = None, priority: int = 0,
+                 **modifiers: Any) -> None:
+        object.__setattr__(self, "_label", label)
+        object.__setattr__(self, "_pos", pos)
+        object.__setattr__(self, "_priority", priority)
+        object.__setattr__(self, "_bg_owner", None)
+        super().__init__(name, **modifiers)
+        for pname, port in self._children.items():
+            if isinstance(port, PowerPort):
+                object.__setattr__(port, "_owner", self)
+                object.__setattr__(port, "_default", self._port_defaults.get(pname, 1))
+
+    # -- description for the pure graph ----------------------------------------------------
+    def label(self) -> str:
+        if self._label is not None:
+            return self._label
+        if self._main and self._main in self._symbols:
+            name = symbol_name(self._symbols[self._main].decl.value)
+            if name is not None:
+                return name
+        return self.name or self.kind
+
+    def modulus_text(self) -> str:
+        return ""
+
+    def power_ports(self) -> list[PowerPort]:
+        return [p for p in self._children.values() if isinstance(p, PowerPort)]
+
+    def free_port(self) -> PowerPort | None:
+        for p in self.power_ports():
+            if not p.bonded:
+                return p
+        return None
+
+
+# -- sources ---------------------------------------------------------------------------------
+class _Source(BGElement):
+    _port_defaults = {"port": -1}
+    _value_name = ""
+
+    def __init__(self, name: str | None = None, *, value: Any = None, signal: bool = False,
+                 **kw: Any) -> None:
+        object.__setattr__(self, "_expr", value)
+        object.__setattr__(self, "_signal", signal)
+        super().__init__(name, **kw)
+        if signal:
+            declare(self, "u", Input(description=f"Imposed {self._value_name}"))
+
+    def value(self) -> Any:
+        if self._signal:
+            return self.u
+        if self._expr is not None:
+            return resolve(self._expr, self, self._value_name)
+        return getattr(self, self._main)
+
+    def label(self) -> str:
+        if self._label is None and (self._signal or self._expr is not None):
+            if isinstance(self._expr, str):
+                return self._expr
+            return self.name or self.kind
+        return super().label()
+
+    def modulus_text(self) -> str:
+        if self._expr is None or self._signal:
+            return ""
+        return self._expr if isinstance(self._expr, str) else str(self.value())
+
+
+class Se(_Source):
+    """Effort source ``e = E``. ``Se(E=12)``; ``Se(value=expr)`` (a time expression, model
+    expression, callable or string); ``Se(signal=True)`` adds an Input ``u`` and ``e = u``."""
+
+    kind = "Se"
+    _main = "E"
+    _value_name = "effort"
+    E = Parameter(0.0, description="Imposed effort")
+    port = PowerPort()
+
+    def equations(self):
+        yield self.port.e == self.value()
+
+
+class Sf(_Source):
+    """Flow source ``f = F`` (along the half-arrow, out of the source by default). Same
+    options as :class:`Se` (``value=``, ``signal=True``)."""
+
+    kind = "Sf"
+    _main = "F"
+    _value_name = "flow"
+    F = Parameter(0.0, description="Imposed flow")
+    port = PowerPort()
+
+    def equations(self):
+        yield bond_flow(self.port) == self.value()
+
+
+# -- passive one-ports -------------------------------------------------------------------------
+class _Passive(BGElement):
+    def __init__(self, name: str | None = None, *, law: Any = None, **kw: Any) -> None:
+        object.__setattr__(self, "_law", law)
+        super().__init__(name, **kw)
+
+
+class R(_Passive):
+    """Dissipator. Linear ``e = R f``; nonlinear ``R(law=lambda e, f: e == ...)``."""
+
+    kind = "R"
+    _main = "R"
+    R = Parameter(1.0, description="Resistance (effort per flow)")
+    port = PowerPort()
+
+    def equations(self):
+        e, f = self.port.e, bond_flow(self.port)
+        if self._law is not None:
+            yield from _law(self._law, [e, f], self)
+        else:
+            yield e == self.R * f
+
+
+class C(_Passive):
+    """Capacitive storage: ``dq/dt = f``; linear ``C e = q``; nonlinear
+    ``C(law=lambda e, q: e == q**3/k)``. State: displacement ``q`` (start via ``C(q=...)``)."""
+
+    kind = "C"
+    _main = "C"
+    C = Parameter(1.0, description="Compliance (displacement per effort)")
+    q = Variable(description="Generalized displacement (integral of the flow)")
+    port = PowerPort()
+
+    def equations(self):
+        e, f = self.port.e, bond_flow(self.port)
+        yield _der(self.q) == f
+        if self._law is not None:
+            yield from _law(self._law, [e, self.q], self)
+        else:
+            yield self.C * e == self.q
+
+
+class I(_Passive):  # noqa: E742
+    """Inertial storage: ``dp/dt = e``; linear ``I f = p``; nonlinear
+    ``I(law=lambda f, p: ...)``. State: momentum ``p`` (start via ``I(p=...)``)."""
+
+    kind = "I"
+    _main = "I"
+    I = Parameter(1.0, description="Inertance (momentum per flow)")  # noqa: E741
+    p = Variable(description="Generalized momentum (integral of the effort)")
+    port = PowerPort()
+
+    def equations(self):
+        e, f = self.port.e, bond_flow(self.port)
+        yield _der(self.p) == e
+        if self._law is not None:
+            yield from _law(self._law, [f, self.p], self)
+        else:
+            yield self.I * f == self.p
+
+
+def _der(x: Any) -> Any:
+    return _expressions.der(x)
+
+
+# -- two-ports ---------------------------------------------------------------------------------
+class _TwoPort(BGElement):
+    _port_defaults = {"p1": 1, "p2": -1}
+    p1 = PowerPort()
+    p2 = PowerPort()
+
+    def _check_through(self) -> tuple[Any, Any, Any, Any]:
+        s1, s2 = orientation(self.p1), orientation(self.p2)
+        if s1 == s2:
+            way = "into" if s1 > 0 else "out of"
+            raise BondError(f"{self.kind} {element_path(self)}: both bonds point {way} it; a "
+                            "transformer or gyrator passes power through, one bond in and "
+                            "one out", element_path(self))
+        return self.p1.e, bond_flow(self.p1), self.p2.e, bond_flow(self.p2)
+
+
+class TF(_TwoPort):
+    """Transformer ``e1 = m e2``, ``f2 = m f1`` (ports ``p1``, ``p2``). Parameter: m."""
+
+    kind = "TF"
+    _main = "m"
+    m = Parameter(1.0, description="Transformer modulus")
+
+    def modulus(self) -> Any:
+        return self.m
+
+    def equations(self):
+        e1, f1, e2, f2 = self._check_through()
+        m = self.modulus()
+        yield e1 == m * e2
+        yield f2 == m * f1
+
+
+class GY(_TwoPort):
+    """Gyrator ``e1 = r f2``, ``e2 = r f1`` (ports ``p1``, ``p2``). Parameter: r."""
+
+    kind = "GY"
+    _main = "r"
+    r = Parameter(1.0, description="Gyrator modulus")
+
+    def modulus(self) -> Any:
+        return self.r
+
+    def equations(self):
+        e1, f1, e2, f2 = self._check_through()
+        r = self.modulus()
+        yield e1 == r * f2
+        yield e2 == r * f1
+
+
+class _Modulated(_TwoPort):
+    def __init__(self, name: str | None = None, *, m: Any = None, **kw: Any) -> None:
+        if m is None:
+            raise ModulusError(f"{self.kind} {name or ''}: a modulus m= is required "
+                               "(number, expression, callable or string)", name)
+        object.__setattr__(self, "_modulus", m)
+        super().__init__(name, **kw)
+
+    def modulus(self) -> Any:
+        return resolve(self._modulus, self, "modulus")
+
+    def modulus_text(self) -> str:
+        if isinstance(self._modulus, str):
+            return self._modulus
+        return str(self.modulus())
+
+
+class MTF(_Modulated, TF):
+    """Modulated transformer: like :class:`TF` with ``m`` an expression of model variables:
+    ``MTF(m=lambda bg: -bg.lc1*sin(bg.q1))`` or ``MTF(m="-lc1*sin(q1)")``."""
+
+    kind = "MTF"
+    _main = None
+
+
+class MGY(_Modulated, GY):
+    """Modulated gyrator: like :class:`GY` with ``r`` given as ``m=`` (an expression)."""
+
+    kind = "MGY"
+    _main = None
+
+
+# -- junctions ---------------------------------------------------------------------------------
+class _Junction(BGElement):
+    _port_defaults: ClassVar[dict[str, int]] = {}
+
+    def new_port(self) -> PowerPort:
+        k = 1 + sum(isinstance(c, PowerPort) for c in self._children.values())
+        while f"p{k}" in self._children:
+            k += 1
+        port = PowerPort()
+        object.__setattr__(port, "_owner", self)
+        self.add(f"p{k}", port)
+        return port
+
+    def _ports(self) -> list[PowerPort]:
+        ports = self.power_ports()
+        if len(ports) < 2:
+            raise JunctionError(f"{self.kind}-junction {element_path(self)} has {len(ports)} "
+                                f"bond{'s' if len(ports) != 1 else ''}; a junction needs at "
+                                "least two", element_path(self))
+        return ports
+
+    def label(self) -> str:
+        return self._label if self._label is not None else (self.name or "")
+
+
+class ZeroJunction(_Junction):
+    """0-junction: common effort ``e``; the bond flows, signed by their half-arrows (in +,
+    out -), sum to zero. Ports ``p1, p2, ...`` are created by :meth:`BondGraph.bond`."""
+
+    kind = "0"
+    e = Variable(description="Common effort")
+
+    def equations(self):
+        ports = self._ports()
+        for p in ports:
+            yield p.e == self.e
+        yield sum((p.f for p in ports[1:]), ports[0].f) == 0
+
+
+class OneJunction(_Junction):
+    """1-junction: common flow ``f`` (along each half-arrow); the efforts, signed by their
+    half-arrows (in +, out -), sum to zero."""
+
+    kind = "1"
+    f = Variable(description="Common flow")
+
+    def equations(self):
+        ports = self._ports()
+        total: Any = 0.0
+        for k, p in enumerate(ports):
+            s = orientation(p)
+            yield s * p.f == self.f
+            term = p.e if s > 0 else -p.e
+            total = term if k == 0 else total + term
+        yield total == 0
+
+
+J0 = ZeroJunction
+J1 = OneJunction
+
+
+# -- detectors ---------------------------------------------------------------------------------
+class De(BGElement):
+    """Effort detector: output ``y = e``; draws no flow."""
+
+    kind = "De"
+    port = PowerPort()
+    y = Output(description="Measured effort")
+
+    def equations(self):
+        yield bond_flow(self.port) == 0
+        yield self.y == self.port.e
+
+
+class Df(BGElement):
+    """Flow detector: output ``y = f``; imposes no effort."""
+
+    kind = "Df"
+    port = PowerPort()
+    y = Output(description="Measured flow")
+
+    def equations(self):
+        yield self.port.e == 0
+        yield self.y == bond_flow(self.port)
+
+
+class Dq(BGElement):
+    """Displacement detector (a Df followed by an integrator): ``dy/dt = f``, imposes no
+    effort. Measures e.g. a joint angle from the joint speed; ``Dq(y=0.3)`` sets y(0)."""
+
+    kind = "Df"
+    port = PowerPort()
+    y = Output(description="Integral of the measured flow")
+
+    def equations(self):
+        yield self.port.e == 0
+        yield _der(self.y) == bond_flow(self.port)
+
