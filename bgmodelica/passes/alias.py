@@ -33,7 +33,9 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
 
     new_vars = list(variables)
     _merge_metadata(new_vars, classes.rep, classes.sign)
-    old, new = [], []
+    old: list[ca.SX] = []
+    new_rep: list[ca.SX] = []
+    new_sign: list[float] = []
     eliminated: set[int] = set()
     aliases = dict(model.aliases)
     for i, v in enumerate(variables):
@@ -42,7 +44,8 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
             continue
         s = classes.sign[i]
         old.append(v.sx)
-        new.append(s * variables[r].sx)
+        new_rep.append(variables[r].sx)
+        new_sign.append(s)
         eliminated.add(i)
         aliases[v.name] = (variables[r].name, s)
         below_old, below_new = i, r
@@ -50,13 +53,20 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
             d_old = variables[below_old].der
             d_new = _ensure_derivative(new_vars, below_new)
             old.append(variables[d_old].sx)
-            new.append(s * new_vars[d_new].sx)
+            new_rep.append(new_vars[d_new].sx)
+            new_sign.append(s)
             aliases[variables[d_old].name] = (new_vars[d_new].name, s)
             eliminated.add(d_old)
             below_old, below_new = d_old, d_new
 
     kept = [eq for k, eq in enumerate(model.equations) if k not in used]
-    residuals = ca.substitute([eq.residual for eq in kept], old, new) if kept else []
+    residuals: list[ca.SX] = []
+    if kept:
+        targets = ca.vertcat(*[eq.residual for eq in kept])
+        if old:
+            targets = ca.substitute(targets, ca.vertcat(*old),
+                                    ca.vertcat(*new_rep) * ca.DM(new_sign))
+        residuals = ca.vertsplit(targets) if len(kept) > 1 else [targets]
     equations = [FlatEquation(res, eq.origin) for res, eq in zip(residuals, kept, strict=True)]
     keep_idx = [i for i in range(len(new_vars)) if i not in eliminated]
     remap = {old_i: new_i for new_i, old_i in enumerate(keep_idx)}

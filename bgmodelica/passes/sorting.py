@@ -19,7 +19,7 @@ import casadi as ca
 from ..errors import UnbalancedModelError
 from ..structure import block_lower_triangular, maximum_matching, tear
 from .index_reduction import ReducedModel
-from .symbolic import solve_linear_block, solve_linear_scalar
+from .symbolic import solve_linear_block, solve_linear_scalar, solve_scalar_blocks
 
 
 @dataclass
@@ -45,7 +45,8 @@ class SortedDAE:
     assignments: list[tuple[int, ca.SX]]
     algebraic: list[int]
     residuals: list[ca.SX]
-    blocks: list[BlockInfo]
+    blocks: list[BlockInfo]          # loops and nonlinear scalar blocks
+    n_explicit: int = 0              # scalar blocks solved explicitly
 
     @property
     def model(self):
@@ -84,26 +85,35 @@ def sort_equations(reduced: ReducedModel) -> SortedDAE:
     res = [e.residual for e in model.equations]
     sym = [variables[j].sx for j in unknowns]
     out = SortedDAE(reduced, [], [], [], [])
-    for block in block_lower_triangular(eq_cols, len(unknowns), matching):
+    blocks = block_lower_triangular(eq_cols, len(unknowns), matching)
+    scalar = [b for b in blocks if len(b.eqs) == 1]
+    solved = solve_scalar_blocks([res[b.eqs[0]] for b in scalar],
+                                 [sym[b.vars[0]] for b in scalar])
+    explicit = {id(b): expr for b, expr in zip(scalar, solved, strict=True)}
+    var_hashes: set[int] = set()
+    for block in blocks:
         eqs, cols = list(block.eqs), list(block.vars)
-        names = [variables[unknowns[c]].name for c in cols]
         if len(eqs) == 1:
-            expr = solve_linear_scalar(res[eqs[0]], sym[cols[0]])
+            expr = explicit[id(block)]
             if expr is not None:
                 out.assignments.append((unknowns[cols[0]], expr))
-                out.blocks.append(BlockInfo(1, "explicit", names))
+                out.n_explicit += 1
                 continue
+            names = [variables[unknowns[cols[0]]].name]
             out.algebraic.append(unknowns[cols[0]])
             out.residuals.append(res[eqs[0]])
             out.blocks.append(BlockInfo(1, "nonlinear", names, names))
             continue
-        _loop(out, eqs, cols, eq_cols, res, sym, unknowns, names, variables)
+        if not var_hashes:
+            var_hashes.update(v.sx.element_hash() for v in variables)
+        names = [variables[unknowns[c]].name for c in cols]
+        _loop(out, eqs, cols, eq_cols, res, sym, unknowns, names, variables, var_hashes)
     return out
 
 
-def _loop(out: SortedDAE, eqs, cols, eq_cols, res, sym, unknowns, names, variables) -> None:
+def _loop(out: SortedDAE, eqs, cols, eq_cols, res, sym, unknowns, names, variables,
+          var_hashes: set[int]) -> None:
     cache: dict[tuple[int, int], ca.SX | None] = {}
-    var_hashes = {v.sx.element_hash() for v in variables}
 
     def solved(e: int, c: int) -> ca.SX | None:
         if (e, c) not in cache:

@@ -66,3 +66,44 @@ def solve_linear_block(residuals: Sequence[ca.SX], vars_: Sequence[ca.SX],
         return None
     b = ca.substitute(r, v, ca.DM.zeros(v.numel()))
     return ca.solve(a, -b)
+
+
+def solve_scalar_blocks(residuals: Sequence[ca.SX],
+                        vars_: Sequence[ca.SX]) -> list[ca.SX | None]:
+    """Solve each ``residuals[k] = 0`` for ``vars_[k]`` where it is linear in it (else None).
+
+    Vectorized: the pairs are colored so that no residual of a color depends on another
+    variable of that color; then one Jacobian and one substitution per color give every
+    coefficient ``a`` and remainder ``b`` (``r = a*v + b``), and ``v = -b/a``.
+    """
+    n = len(residuals)
+    if n == 0:
+        return []
+    r_all, v_all = ca.vertcat(*residuals), ca.vertcat(*vars_)
+    rows, cols = ca.jacobian_sparsity(r_all, v_all).get_triplet()
+    neighbours: list[set[int]] = [set() for _ in range(n)]
+    for i, j in zip(rows, cols, strict=True):
+        if i != j:
+            neighbours[i].add(j)
+            neighbours[j].add(i)
+    color = [-1] * n
+    for k in range(n):
+        used = {color[j] for j in neighbours[k] if color[j] >= 0}
+        c = 0
+        while c in used:
+            c += 1
+        color[k] = c
+    out: list[ca.SX | None] = [None] * n
+    for c in range(max(color) + 1):
+        members = [k for k in range(n) if color[k] == c]
+        r = r_all[members]
+        v = v_all[members]
+        a = ca.jtimes(r, v, ca.DM.ones(len(members)))      # diagonal: no cross terms
+        nonlinear = set(ca.jacobian_sparsity(a, v).get_triplet()[0])
+        b = ca.substitute(r, v, ca.DM.zeros(len(members)))
+        sol = ca.vertsplit(-b / a) if len(members) > 1 else [-b / a]
+        a_parts = ca.vertsplit(a) if len(members) > 1 else [a]
+        for m, k in enumerate(members):
+            if m not in nonlinear and not a_parts[m].is_zero():
+                out[k] = sol[m]
+    return out
