@@ -133,14 +133,22 @@ def _output_indices(dae: CasadiDAE, outputs: Sequence[str] | None) -> list[int]:
 
 
 def _observer(dae: CasadiDAE, idx: list[int]) -> Callable:
+    """Evaluate the observed variables ``idx`` on a grid, reading only the states and
+    algebraic variables they depend on."""
     expr = ca.vertcat(*[dae.observed[k] for k in idx]) if idx else ca.SX(0, 1)
-    f = ca.Function("observe", [dae.t, dae.x, dae.z, dae.p], [expr])
+    used_x = sorted(set(ca.jacobian_sparsity(expr, dae.x).get_triplet()[1])) \
+        if dae.x.numel() else []
+    used_z = sorted(set(ca.jacobian_sparsity(expr, dae.z).get_triplet()[1])) \
+        if dae.z.numel() else []
+    xs = ca.vertcat(*[dae.x[i] for i in used_x]) if used_x else ca.SX(0, 1)
+    zs = ca.vertcat(*[dae.z[i] for i in used_z]) if used_z else ca.SX(0, 1)
+    f = ca.Function("observe", [dae.t, xs, zs, dae.p], [expr])
 
-    def run(times, xs, zs, p):
+    def run(times, x_traj, z_traj, p):
         n = len(times)
-        fm = f.map(n)
-        out = fm(times.reshape(1, -1), xs, zs if zs.size else np.zeros((0, n)),
-                 np.repeat(np.asarray(p).reshape(-1, 1), n, axis=1))
+        out = f.map(n)(times.reshape(1, -1), x_traj[used_x, :],
+                       z_traj[used_z, :] if used_z else np.zeros((0, n)),
+                       np.repeat(np.asarray(p).reshape(-1, 1), n, axis=1))
         return np.asarray(out).T.reshape(n, len(idx))
 
     return run

@@ -207,13 +207,24 @@ class _Flattener:
             if len(syms) == 2:
                 pairs.add(syms[0], syms[1], signs[0] * signs[1], origin)
             else:
-                idx = [self.pos[id(s)] for s in syms]
-                total = ca.dot(self.all_sx[idx], ca.DM(signs)) if len(idx) > 1 \
-                    else self.all_sx[idx[0]]
-                self.equations.append(FlatEquation(total, origin))
+                pairs.add_sum(syms, signs, origin)
 
     def _emit_pairs(self, pairs: _Pairs) -> None:
-        """Residuals ``a + c*b`` of all two-symbol connection equations in one operation."""
+        """Residuals ``a + c*b`` of all two-symbol connection equations in one operation,
+        then the flow sums of larger sets as one sparse matrix product."""
+        if pairs.sums:
+            rows, cols, vals = [], [], []
+            for k, (syms, signs, _) in enumerate(pairs.sums):
+                for sym, sgn in zip(syms, signs, strict=True):
+                    rows.append(k)
+                    cols.append(self.pos[id(sym)])
+                    vals.append(sgn)
+            sel = ca.DM(ca.Sparsity.triplet(len(pairs.sums), self.all_sx.numel(), rows, cols),
+                        vals)
+            totals = ca.mtimes(sel, self.all_sx)
+            parts = ca.vertsplit(totals) if len(pairs.sums) > 1 else [totals]
+            for total, (_, _, origin) in zip(parts, pairs.sums, strict=True):
+                self.equations.append(FlatEquation(total, origin))
         if not pairs.a:
             return
         ia = [self.pos[id(s)] for s in pairs.a]
@@ -318,6 +329,10 @@ class _Pairs:
         self.b: list[Symbol] = []
         self.coef: list[float] = []
         self.origin: list[str] = []
+        self.sums: list[tuple[list[Symbol], list[float], str]] = []
+
+    def add_sum(self, syms: list[Symbol], signs: list[float], origin: str) -> None:
+        self.sums.append((syms, signs, origin))
 
     def add(self, a: Symbol, b: Symbol, coef: float, origin: str) -> None:
         self.a.append(a)

@@ -127,12 +127,9 @@ def derivative_unit(unit: str) -> str:
         return ""
     if unit == "1":
         return "1/s"
-    m = re.match(r"^(.*)/s(\d*)$", unit)
-    if m and "/" not in m.group(1):
-        power = int(m.group(2) or "1") + 1
-        return f"{m.group(1)}/s{power}"
-    if "/" in unit:
-        return f"{unit}/s"
+    m = re.match(r"^([^/]*)/s(\d*)$", unit)
+    if m:
+        return f"{m.group(1)}/s{int(m.group(2) or '1') + 1}"
     return f"{unit}/s"
 
 
