@@ -140,15 +140,18 @@ def _observer(dae: CasadiDAE, idx: list[int]) -> Callable:
         if dae.x.numel() else []
     used_z = sorted(set(ca.jacobian_sparsity(expr, dae.z).get_triplet()[1])) \
         if dae.z.numel() else []
+    used_p = sorted(set(ca.jacobian_sparsity(expr, dae.p).get_triplet()[1])) \
+        if dae.p.numel() else []
     xs = ca.vertcat(*[dae.x[i] for i in used_x]) if used_x else ca.SX(0, 1)
     zs = ca.vertcat(*[dae.z[i] for i in used_z]) if used_z else ca.SX(0, 1)
-    f = ca.Function("observe", [dae.t, xs, zs, dae.p], [expr])
+    ps = ca.vertcat(*[dae.p[i] for i in used_p]) if used_p else ca.SX(0, 1)
+    f = ca.Function("observe", [dae.t, xs, zs, ps], [expr])
 
     def run(times, x_traj, z_traj, p):
         n = len(times)
         out = f.map(n)(times.reshape(1, -1), x_traj[used_x, :],
                        z_traj[used_z, :] if used_z else np.zeros((0, n)),
-                       np.repeat(np.asarray(p).reshape(-1, 1), n, axis=1))
+                       np.asarray(p)[used_p])     # broadcast over the grid
         return np.asarray(out).T.reshape(n, len(idx))
 
     return run

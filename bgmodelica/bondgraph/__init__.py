@@ -8,8 +8,11 @@ causality (SCAP, BGI/BGD views), structural controllability/observability, causa
 """
 
 from .causality import BGD, BGI, Causality, Conflict, assign_causality, signal_graph
+from .draw import draw, layout
 from .elements import (
     GY,
+    J0,
+    J1,
     MGY,
     MTF,
     TF,
@@ -19,8 +22,6 @@ from .elements import (
     Df,
     Dq,
     I,
-    J0,
-    J1,
     OneJunction,
     PowerPort,
     R,
@@ -40,6 +41,7 @@ from .errors import (
 )
 from .graph import Bond, Graph, Node
 from .model import BondGraph, graph_of
+from .report import BondGraphReport, analyze
 from .structural import StructuralProperty, controllability, observability
 
 __all__ = [
@@ -49,5 +51,6 @@ __all__ = [
     "assign_causality", "Causality", "Conflict", "BGI", "BGD", "signal_graph",
     "controllability", "observability", "StructuralProperty",
     "causal_equations", "CausalEquations",
+    "analyze", "BondGraphReport", "draw", "layout",
     "BondGraphError", "BondError", "JunctionError", "ModulusError", "CausalConflictError",
 ]

@@ -209,13 +209,14 @@ class _Assigner:
 
 
 def assign_causality(graph: Graph, view: str = BGI, dualize: frozenset[str] | set[str] = (),
-                     check: bool = True) -> Causality:
+                     check: bool = True, keep: list[str] | None = None) -> Causality:
     """Run SCAP on ``graph``.
 
     view: ``"BGI"`` (storage prefers integral causality) or ``"BGD"`` (derivative).
     dualize: element kinds ("Se", "Sf", "De", "Df") whose causality is left free, as for the
     rank conditions of structural controllability (sources) and observability (detectors).
     check: validate the graph first (junction bond counts, two-port directions).
+    keep: names of elements whose causality stays fixed even if their kind is dualized.
     """
     if check:
         graph.validate()
@@ -223,8 +224,13 @@ def assign_causality(graph: Graph, view: str = BGI, dualize: frozenset[str] | se
     res = Causality(graph, view, a.eto)
     order = list(graph.nodes.values())
     inc = a.inc
-    fixed = [n for n in order if (n.kind in SOURCES | DETECTORS) and n.kind not in dualize]
-    free = [n for n in order if n.kind in ("R", "X") or (n.kind in dualize)]
+    kept = set(keep or ())
+
+    def dual(n: Node) -> bool:
+        return n.kind in dualize and n.name not in kept
+
+    fixed = [n for n in order if (n.kind in SOURCES | DETECTORS) and not dual(n)]
+    free = [n for n in order if n.kind in ("R", "X") or dual(n)]
     storage = sorted((n for n in order if n.kind in STORAGE),
                      key=lambda n: -n.priority)          # stable: declaration order kept
     preferred = "integral" if view == BGI else "derivative"
@@ -286,7 +292,7 @@ def assign_causality(graph: Graph, view: str = BGI, dualize: frozenset[str] | se
         if n.kind in STORAGE:
             integral = into if n.kind == "I" else not into
             res.storage[n.name] = "integral" if integral else "derivative"
-        elif n.kind in ("R", "X") or n.kind in dualize:
+        elif n.kind in ("R", "X") or dual(n):
             res.resistors[n.name] = "conductance" if into else "resistance"
         elif n.kind in SOURCES | DETECTORS:
             want = _wanted(n, "")

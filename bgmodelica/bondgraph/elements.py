@@ -288,11 +288,18 @@ class _Source(BGElement):
 
     def __init__(self, name: str | None = None, *, value: Any = None, signal: bool = False,
                  **kw: Any) -> None:
+        main = kw.pop(self._main, None)
+        if main is not None and (value is not None or signal):
+            raise ModulusError(f"{self.kind} {name or ''}: give either {self._main}=, value= "
+                               "or signal=True", name)
         object.__setattr__(self, "_expr", value)
         object.__setattr__(self, "_signal", signal)
         super().__init__(name, **kw)
         if signal:
             declare(self, "u", Input(description=f"Imposed {self._value_name}"))
+        elif value is None:
+            declare(self, self._main, Parameter(0.0 if main is None else main,
+                                                description=f"Imposed {self._value_name}"))
 
     def value(self) -> Any:
         if self._signal:
@@ -315,13 +322,13 @@ class _Source(BGElement):
 
 
 class Se(_Source):
-    """Effort source ``e = E``. ``Se(E=12)``; ``Se(value=expr)`` (a time expression, model
-    expression, callable or string); ``Se(signal=True)`` adds an Input ``u`` and ``e = u``."""
+    """Effort source ``e = E``. ``Se(E=12)`` (parameter ``E``); ``Se(value=expr)`` (a time
+    expression, model expression, callable or string); ``Se(signal=True)`` adds an Input ``u``
+    and ``e = u``."""
 
     kind = "Se"
     _main = "E"
     _value_name = "effort"
-    E = Parameter(0.0, description="Imposed effort")
     port = PowerPort()
 
     def equations(self):
@@ -330,12 +337,11 @@ class Se(_Source):
 
 class Sf(_Source):
     """Flow source ``f = F`` (along the half-arrow, out of the source by default). Same
-    options as :class:`Se` (``value=``, ``signal=True``)."""
+    options as :class:`Se` (``F=``, ``value=``, ``signal=True``)."""
 
     kind = "Sf"
     _main = "F"
     _value_name = "flow"
-    F = Parameter(0.0, description="Imposed flow")
     port = PowerPort()
 
     def equations(self):
@@ -474,19 +480,20 @@ class _Modulated(_TwoPort):
         return str(self.modulus())
 
 
-class MTF(_Modulated, TF):
+class MTF(_Modulated):
     """Modulated transformer: like :class:`TF` with ``m`` an expression of model variables:
     ``MTF(m=lambda bg: -bg.lc1*sin(bg.q1))`` or ``MTF(m="-lc1*sin(q1)")``."""
 
     kind = "MTF"
-    _main = None
+    equations = TF.equations
 
 
-class MGY(_Modulated, GY):
-    """Modulated gyrator: like :class:`GY` with ``r`` given as ``m=`` (an expression)."""
+class MGY(_Modulated):
+    """Modulated gyrator: like :class:`GY` with its modulus given as ``m=`` (an
+    expression)."""
 
     kind = "MGY"
-    _main = None
+    equations = GY.equations
 
 
 # -- junctions ---------------------------------------------------------------------------------

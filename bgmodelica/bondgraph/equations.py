@@ -123,19 +123,29 @@ def neg(e: Ex) -> Ex:
     return Sum([(-1, e)])
 
 
+def _is_zero(t: Ex) -> bool:
+    return isinstance(t, Sym) and t.t == "0"
+
+
 def add(terms: list[tuple[int, Ex]]) -> Ex:
     flat: list[tuple[int, Ex]] = []
     for s, t in terms:
+        if _is_zero(t):
+            continue
         if isinstance(t, Sum):
             flat.extend((s * s2, t2) for s2, t2 in t.terms)
         else:
             flat.append((s, t))
+    if not flat:
+        return Sym("0", "0")
     if len(flat) == 1 and flat[0][0] > 0:
         return flat[0][1]
     return Sum(flat)
 
 
 def div(a: Ex, b: Ex) -> Ex:
+    if _is_zero(a):
+        return a
     if isinstance(a, Sum) and len(a.terms) == 1:            # (-x)/m -> -(x/m)
         s, t = a.terms[0]
         return add([(s, div(t, b))])
@@ -143,6 +153,8 @@ def div(a: Ex, b: Ex) -> Ex:
 
 
 def mul(a: Ex, b: Ex) -> Ex:
+    if _is_zero(a) or _is_zero(b):
+        return Sym("0", "0")
     if isinstance(b, Sum) and len(b.terms) == 1:           # a*(-x) -> -(a*x)
         s, t = b.terms[0]
         return add([(s, mul(a, t))])
@@ -166,7 +178,9 @@ def var(kind: str, k: int) -> Sym:
 
 
 def param(node_symbol: str) -> Sym:
-    return Sym(node_symbol, _tex_name(node_symbol))
+    if node_symbol.isidentifier():
+        return Sym(node_symbol, _tex_name(node_symbol))
+    return Sym(f"({node_symbol})", rf"\left(\mathrm{{{node_symbol}}}\right)")
 
 
 # -- the causal equations ------------------------------------------------------------------
@@ -321,7 +335,7 @@ def causal_equations(c: Causality) -> CausalEquations:
             continue
         k = bonds[0].number
         into = eto[k] == name
-        src = Sym(n.symbol, _tex_name(n.symbol))
+        src = param(n.symbol)
         if n.kind == "Se":
             rhs = Sym("0", "0") if n.zero else src
             out.elements.append(CausalEquation(name, title, e(k), rhs))

@@ -37,7 +37,7 @@ from typing import Any
 from ..core.component import Component, Element
 from ..core.variables import StateSelect
 from .causality import assign_causality
-from .elements import BGElement, PowerPort, _Junction, element_path
+from .elements import BGElement, Dq, PowerPort, _Junction, element_path
 from .errors import BondError, CausalConflictError
 from .graph import Graph
 
@@ -45,7 +45,18 @@ __all__ = ["BondGraph", "graph_of"]
 
 
 class BondGraph(Component):
-    """A component made of bond-graph elements and bonds; nests as a subsystem."""
+    """A component made of bond-graph elements and bonds; nests as a subsystem.
+
+    ``causal_states`` (class attribute) sets how the causality of the outermost bond graph
+    guides state selection: ``"auto"`` (default) gives the energy variables of storage
+    elements in integral causality (and the outputs of displacement detectors)
+    ``StateSelect.ALWAYS`` when the graph is closed (no adapter, no open port) and ``PREFER``
+    otherwise; ``"always"``, ``"prefer"`` force one of these; ``"off"`` leaves them alone.
+    Storage elements in derivative causality get ``AVOID``. A ``state_select`` given by the
+    user is never overridden.
+    """
+
+    causal_states: str = "auto"
 
     def __init__(self, name: str | None = None, *, pos: tuple[float, float] | None = None,
                  **modifiers: Any) -> None:
@@ -174,15 +185,26 @@ class BondGraph(Component):
                 "causal conflict in " + (self.name or type(self).__name__) + ": "
                 + "; ".join(f"{x.element}: {x.message}" for x in causal.conflicts),
                 c.element, causal.conflicts)
+        mode = self.causal_states
+        if mode == "off":
+            return
+        closed = not any(n.kind == "X" or n.zero for n in graph.nodes.values())
+        strong = StateSelect.ALWAYS if (mode == "always" or (mode == "auto" and closed)) \
+            else StateSelect.PREFER
         elements = _elements_by_path(self)
+
+        def hint(sym, pick):
+            if getattr(sym.decl, "state_select", StateSelect.DEFAULT) == StateSelect.DEFAULT:
+                sym.decl = replace(sym.decl, state_select=pick)
+
         for name, how in causal.storage.items():
             elem = elements.get(name)
-            if elem is None:
-                continue
-            sym = elem._symbols["p" if elem.kind == "I" else "q"]
-            if getattr(sym.decl, "state_select", StateSelect.DEFAULT) == StateSelect.DEFAULT:
-                pick = StateSelect.PREFER if how == "integral" else StateSelect.AVOID
-                sym.decl = replace(sym.decl, state_select=pick)
+            if elem is not None:
+                hint(elem._symbols["p" if elem.kind == "I" else "q"],
+                     strong if how == "integral" else StateSelect.AVOID)
+        for elem in elements.values():
+            if isinstance(elem, Dq):
+                hint(elem._symbols["y"], strong)
 
 
 def _elements_by_path(root: Component) -> dict[str, BGElement]:

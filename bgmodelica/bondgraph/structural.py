@@ -18,6 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from .causality import BGD, Causality, assign_causality, path_to, reach, signal_graph
+from .errors import BondError
 from .graph import Graph
 
 
@@ -28,14 +29,15 @@ class StructuralProperty:
     ok: both conditions hold. states: storage elements in integral causality (the BGI
     states). unconnected: those without a causal path to a source (detector). bgd_integral:
     storage left in integral causality in the BGD with dualized sources (detectors).
-    rank: structural rank of [A B] (of [A; C]); n: number of states. paths: state ->
-    list of bonds of one causal path (source first / detector last).
+    rank: structural rank of [A B] (of [A; C]); n: number of states. connected_to: state ->
+    the sources (detectors) causally connected to it, nearest first; paths: state -> the
+    bonds of the shortest such causal path (source first / detector last).
     """
 
     kind: str
     ok: bool
     states: list[str]
-    connected_to: dict[str, str] = field(default_factory=dict)
+    connected_to: dict[str, list[str]] = field(default_factory=dict)
     unconnected: list[str] = field(default_factory=list)
     bgd_integral: list[str] = field(default_factory=list)
     rank: int = 0
@@ -57,51 +59,65 @@ def _bonds_on(path: list[tuple]) -> list[int]:
     return out
 
 
-def controllability(graph: Graph, bgi: Causality | None = None) -> StructuralProperty:
-    """Structural state controllability (Theorem 1 plus the BGD rank condition)."""
-    bgi = bgi or assign_causality(graph)
+def _connect(graph: Graph, bgi: Causality, ends: list[tuple], reverse: bool,
+             out: StructuralProperty) -> None:
     sg = signal_graph(bgi)
-    sources = [("u", n.name) for n in graph.of_kind("Se", "Sf") if not n.zero]
-    states = bgi.integral
-    out = StructuralProperty("controllability", True, list(states), n=len(states))
-    for x in states:
-        best: list[tuple] = []
-        for s in sources:
-            p = path_to(reach(sg, [s]), ("x", x))
-            if p and (not best or len(p) < len(best)):
-                best = p
-        if best:
-            out.connected_to[x] = best[0][1]
-            out.paths[x] = _bonds_on(best)
+    trees = [(e, reach(sg, [e], reverse=reverse)) for e in ends]
+    for x in out.states:
+        found = []
+        for e, tree in trees:
+            p = path_to(tree, ("x", x))
+            if p:
+                found.append((len(p), e[1], p))
+        found.sort(key=lambda t: t[0])
+        if found:
+            out.connected_to[x] = [name for _, name, _ in found]
+            best = found[0][2]
+            out.paths[x] = _bonds_on(best[::-1] if reverse else best)
         else:
             out.unconnected.append(x)
-    bgd = assign_causality(graph, BGD, dualize={"Se", "Sf"}, check=False)
-    out.bgd_integral = [x for x in states if bgd.storage.get(x) == "integral"]
-    out.rank = len(states) - len(out.bgd_integral)
+
+
+def _names(graph: Graph, kinds: tuple[str, ...], only: list[str] | None, what: str
+           ) -> list[str]:
+    names = [n.name for n in graph.of_kind(*kinds) if not n.zero]
+    if only is None:
+        return names
+    missing = [x for x in only if x not in names]
+    if missing:
+        raise BondError(f"{', '.join(missing)}: not {what} of {graph.name} "
+                        f"(it has: {', '.join(names) or 'none'})", missing[0])
+    return list(only)
+
+
+def controllability(graph: Graph, bgi: Causality | None = None,
+                    inputs: list[str] | None = None) -> StructuralProperty:
+    """Structural state controllability (Theorem 1 plus the BGD rank condition).
+    ``inputs``: the sources that count as control inputs (default: every source)."""
+    bgi = bgi or assign_causality(graph)
+    sources = _names(graph, ("Se", "Sf"), inputs, "a source")
+    out = StructuralProperty("controllability", True, list(bgi.integral),
+                             n=len(bgi.integral))
+    _connect(graph, bgi, [("u", s) for s in sources], False, out)
+    fixed = [n.name for n in graph.of_kind("Se", "Sf") if n.name not in sources]
+    bgd = assign_causality(graph, BGD, dualize={"Se", "Sf"}, check=False, keep=fixed)
+    out.bgd_integral = [x for x in out.states if bgd.storage.get(x) == "integral"]
+    out.rank = out.n - len(out.bgd_integral)
     out.ok = not out.unconnected and not out.bgd_integral
     return out
 
 
-def observability(graph: Graph, bgi: Causality | None = None) -> StructuralProperty:
-    """Structural state observability (Theorem 2 plus the BGD rank condition)."""
+def observability(graph: Graph, bgi: Causality | None = None,
+                  outputs: list[str] | None = None) -> StructuralProperty:
+    """Structural state observability (Theorem 2 plus the BGD rank condition).
+    ``outputs``: the detectors that count as measurements (default: every detector)."""
     bgi = bgi or assign_causality(graph)
-    sg = signal_graph(bgi)
-    detectors = [("y", n.name) for n in graph.of_kind("De", "Df")]
-    states = bgi.integral
-    out = StructuralProperty("observability", True, list(states), n=len(states))
-    for x in states:
-        best: list[tuple] = []
-        for d in detectors:
-            p = path_to(reach(sg, [d], reverse=True), ("x", x))
-            if p and (not best or len(p) < len(best)):
-                best = p
-        if best:
-            out.connected_to[x] = best[0][1]
-            out.paths[x] = _bonds_on(best[::-1])
-        else:
-            out.unconnected.append(x)
-    bgd = assign_causality(graph, BGD, dualize={"De", "Df"}, check=False)
-    out.bgd_integral = [x for x in states if bgd.storage.get(x) == "integral"]
-    out.rank = len(states) - len(out.bgd_integral)
+    detectors = _names(graph, ("De", "Df"), outputs, "a detector")
+    out = StructuralProperty("observability", True, list(bgi.integral), n=len(bgi.integral))
+    _connect(graph, bgi, [("y", d) for d in detectors], True, out)
+    fixed = [n.name for n in graph.of_kind("De", "Df") if n.name not in detectors]
+    bgd = assign_causality(graph, BGD, dualize={"De", "Df"}, check=False, keep=fixed)
+    out.bgd_integral = [x for x in out.states if bgd.storage.get(x) == "integral"]
+    out.rank = out.n - len(out.bgd_integral)
     out.ok = not out.unconnected and not out.bgd_integral
     return out
