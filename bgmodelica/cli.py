@@ -9,7 +9,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from .errors import ModelError, ParameterError
+from .errors import ModelError, ModelLoadError, ParameterError
 
 
 def _parse_sets(items: Sequence[str]) -> dict[str, float]:
@@ -108,6 +108,36 @@ def cmd_check(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_export(args: argparse.Namespace) -> int:
+    from .compiler import compile
+    from .fmi.from_model import export_model
+    from .loader import load_model
+
+    compiled = compile(load_model(args.model, **_model_kwargs(args.arg)))
+    path = export_model(compiled, args.output, fmi_version=args.fmi, fmu_type=args.type,
+                        stop_time=args.stop_time, step_size=args.step)
+    print(f"{compiled.name}: FMI {args.fmi}.0 {args.type.upper()} -> {path}")
+    if args.validate:
+        from fmpy.validation import validate_fmu
+
+        problems = validate_fmu(str(path))
+        print("fmpy validate_fmu: " + ("OK" if not problems else "; ".join(problems)))
+        return 1 if problems else 0
+    return 0
+
+
+def cmd_draw(args: argparse.Namespace) -> int:
+    from .bondgraph import BondGraph, draw
+    from .loader import load_model
+
+    model = load_model(args.model, **_model_kwargs(args.arg))
+    if not isinstance(model, BondGraph):
+        raise ModelLoadError(f"{args.model} is a {type(model).__name__}, not a BondGraph")
+    path = draw(model, args.output)
+    print(f"drawing -> {path}")
+    return 0
+
+
 def _bondgraph_report(model: Any) -> Any:
     try:
         from .bondgraph import BondGraph, analyze
@@ -146,6 +176,21 @@ def build_parser() -> argparse.ArgumentParser:
     model_args(chk)
     chk.add_argument("--json", action="store_true", help="machine-readable output")
     chk.set_defaults(func=cmd_check)
+    exp = sub.add_parser("export", help="export an FMU (FMI 2.0/3.0, ME/CS)")
+    model_args(exp)
+    exp.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="FMI version")
+    exp.add_argument("--type", choices=("me", "cs", "both"), default="me",
+                     help="Model Exchange, Co-Simulation or both")
+    exp.add_argument("-o", "--output", default="fmus", help="output directory (default fmus)")
+    exp.add_argument("--stop-time", type=float, default=1.0, help="DefaultExperiment stop [s]")
+    exp.add_argument("--step", type=float, default=None, help="DefaultExperiment step [s]")
+    exp.add_argument("--validate", action="store_true", help="run fmpy's validate_fmu")
+    exp.set_defaults(func=cmd_export)
+
+    drw = sub.add_parser("draw", help="draw a bond graph with causal strokes (SVG/PNG)")
+    model_args(drw)
+    drw.add_argument("-o", "--output", required=True, help="file.svg or file.png")
+    drw.set_defaults(func=cmd_draw)
     for register in _EXTENSIONS:
         register(sub, model_args)
     return parser
@@ -160,6 +205,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args) or 0)
     except ModelError as err:
+        print(f"error: {type(err).__name__}: {err}", file=sys.stderr)
+        return 2
+    except Exception as err:  # FMU build errors and the like: one line, not a traceback
+        from .fmi import FmuExportError
+
+        if not isinstance(err, FmuExportError):
+            raise
         print(f"error: {type(err).__name__}: {err}", file=sys.stderr)
         return 2
 

@@ -29,7 +29,7 @@ class StateSelector:
     """Numerical state selection for a compiled model whose structure leaves a choice."""
 
     base: CompiledModel
-    threshold: float = 0.3
+    threshold: float = 0.1
     variants: dict[tuple[int, ...], CompiledModel] = field(default_factory=dict)
     switches: list[tuple[float, list[str]]] = field(default_factory=list)
 
@@ -54,19 +54,22 @@ class StateSelector:
     def key(dummies: list[int]) -> tuple[int, ...]:
         return tuple(sorted(dummies))
 
-    def needed(self) -> bool:
-        """True when some level's Jacobian depends on the variables (a choice can degrade)."""
+    def needed(self, samples: int = 3, seed: int = 0) -> bool:
+        """True when the pivots of the current choice change with the state, so the choice
+        can degrade (the pendulum's 2x or 2y); False when they are constant (a multibody
+        chain whose joint coordinates are states: triangular blocks with unit pivots)."""
         red = self.base.reduced
-        model = red.model
-        syms = ca.vertcat(*[v.sx for v in model.variables])
-        for rows, cands, _ in red.levels:
-            if len(cands) <= len(rows):
-                continue
-            j = ca.jacobian(ca.vertcat(*[model.equations[r].residual for r in rows]),
-                            ca.vertcat(*[model.variables[c].sx for c in cands]))
-            if ca.depends_on(j, syms):
-                return True
-        return False
+        levels = [lv for lv in red.levels if len(lv[1]) > len(lv[0])]
+        if not levels:
+            return False
+        rng = np.random.default_rng(seed)
+        n = len(red.model.variables)
+        p = self.base.dae.p_default
+        scores = []
+        for _ in range(samples):
+            jac = np.asarray(ca.DM(self._jac(rng.uniform(-2.0, 2.0, n), p, rng.uniform())))
+            scores.append(self._score(jac, levels))
+        return max(scores) - min(scores) > 1e-9 * max(1.0, max(abs(v) for v in scores))
 
     def _score(self, jac: np.ndarray, levels) -> float:
         score = 1.0

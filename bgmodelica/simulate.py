@@ -59,7 +59,7 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
     n_int = max(1, int(round((stop_time - start_time) / interval))) if interval else 500
     grid = np.linspace(start_time, stop_time, n_int + 1)
     init = initialize(dae, p, start_time)
-    obs_idx = _output_indices(dae, outputs)
+    obs_idx = _output_indices(dae, outputs, compiled.reduced.model.aliases)
     observe = _observer(dae, obs_idx)
     opts = {"abstol": atol, "reltol": rtol, "max_num_steps": max_steps,
             "calc_ic": False}   # initialize() already made x0, z0 consistent
@@ -87,8 +87,9 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
             "states": list(dae.state_names), "init_notes": init.notes}
     if selector is not None:
         meta["state_switches"] = selector.switches
-    result = Result(grid[:n_ok], values, names, dict(flat.aliases) if outputs is None else {},
-                    params_out, units, meta)
+    kept = set(names)
+    aliases = {a: rep for a, rep in flat.aliases.items() if rep[0] in kept}
+    result = Result(grid[:n_ok], values, names, aliases, params_out, units, meta)
     if failure is not None:
         t_reached = float(grid[n_ok - 1]) if n_ok else start_time
         hint = next((h for key, h in _HINTS.items() if key in failure), "see the solver message")
@@ -123,13 +124,16 @@ def _with_starts(dae: CasadiDAE, overrides: dict[str, Any]) -> CasadiDAE:
     return replace(dae, fixed=sorted(fixed.items()), x_start=x_start, z_start=z_start)
 
 
-def _output_indices(dae: CasadiDAE, outputs: Sequence[str] | None) -> list[int]:
+def _output_indices(dae: CasadiDAE, outputs: Sequence[str] | None,
+                    aliases: dict[str, tuple[str, float]]) -> list[int]:
     if outputs is None:
         return list(range(len(dae.names)))
-    missing = [n for n in outputs if n not in dae.observed_index]
+    wanted = [aliases[n][0] if n not in dae.observed_index and n in aliases else n
+              for n in outputs]
+    missing = [n for n, w in zip(outputs, wanted, strict=True) if w not in dae.observed_index]
     if missing:
         raise ParameterError(f"unknown output variable(s): {', '.join(missing)}")
-    return [dae.observed_index[n] for n in outputs]
+    return sorted({dae.observed_index[w] for w in wanted})
 
 
 def _observer(dae: CasadiDAE, idx: list[int]) -> Callable:

@@ -243,6 +243,16 @@ def assign_causality(graph: Graph, view: str = BGI, dualize: frozenset[str] | se
     for n in fixed:
         if not inc[n.name]:
             continue
+        bond = inc[n.name][0]
+        if bond.number in a.eto:
+            other = graph.nodes[bond.other(n.name)]
+            want = n.name if _wanted(n, "") == "self" else other.name
+            if a.eto[bond.number] != want:
+                what = "effort" if n.kind in ("Se", "Df") else "flow"
+                res.conflicts.append(Conflict(n.name, other.name, (
+                    f"{n.title} {n.name} cannot impose its {what}: {other.title} "
+                    f"{other.name} already has its {what} imposed through another bond")))
+            continue
         err = a.attempt(lambda n=n: a.one_port(n, _wanted(n, "")))
         if err is not None:
             res.conflicts.append(Conflict(n.name, err.at, err.message))

@@ -136,7 +136,7 @@ def element_path(elem: Any) -> str:
     """Dotted path of an element through the bond graphs that own it."""
     parts = []
     e = elem
-    while e is not None:
+    while e is not None and (e is elem or getattr(e, "_bg_owner", None) is not None):
         if e.name:
             parts.append(e.name)
         e = getattr(e, "_bg_owner", None)
