@@ -16,7 +16,6 @@ from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
-import scipy.linalg
 
 from .compiler import CompiledModel, recompile
 from .core.variables import TIME
@@ -29,7 +28,7 @@ class StateSelector:
     """Numerical state selection for a compiled model whose structure leaves a choice."""
 
     base: CompiledModel
-    threshold: float = 0.1
+    threshold: float = 0.3
     variants: dict[tuple[int, ...], CompiledModel] = field(default_factory=dict)
     switches: list[tuple[float, list[str]]] = field(default_factory=list)
 
@@ -85,9 +84,7 @@ class StateSelector:
         now = self._score(jac, red.levels)
 
         def numeric(level, rows, cands, default):
-            a = jac[np.ix_(rows, cands)]
-            _, _, piv = scipy.linalg.qr(a, pivoting=True, mode="economic")
-            return [cands[k] for k in piv[: len(rows)]]
+            return preferred_pivots(jac[np.ix_(rows, cands)], cands)
 
         try:
             best = dummy_derivatives(red.graph, self.priority, select=numeric)
@@ -103,3 +100,27 @@ class StateSelector:
         nxt = self.variants[key]
         self.switches.append((t, list(nxt.dae.state_names)))
         return nxt
+
+
+def preferred_pivots(a: np.ndarray, cands: list[int], threshold: float = 0.5) -> list[int]:
+    """Choose ``rows`` columns of ``a`` by Gaussian elimination with threshold pivoting: at
+    each step take the first column, in the given preference order, whose largest remaining
+    entry is at least ``threshold`` times the largest available. State-selection priorities
+    (encoded in the candidate order) thus win unless the pivot is numerically poor."""
+    a = np.array(a, dtype=float)
+    rows_left = list(range(a.shape[0]))
+    cols_left = list(range(a.shape[1]))
+    chosen: list[int] = []
+    for _ in range(a.shape[0]):
+        sizes = {j: np.max(np.abs(a[rows_left, j])) for j in cols_left}
+        best = max(sizes.values())
+        j = next(c for c in cols_left if sizes[c] >= threshold * best)
+        i = max(rows_left, key=lambda r: abs(a[r, j]))
+        if a[i, j] != 0.0:
+            for r in rows_left:
+                if r != i:
+                    a[r, :] -= a[r, j] / a[i, j] * a[i, :]
+        rows_left.remove(i)
+        cols_left.remove(j)
+        chosen.append(cands[j])
+    return chosen

@@ -44,16 +44,27 @@ def fmu_spec(model: Component | CompiledModel, *, stop_time: float = 1.0,
     by_name = {v.name: v for v in flat.variables}
     declared_outputs = [v.name for v in flat.variables
                         if v.decl.kind == KIND_OUTPUT and v.component == "" and v.der_of < 0]
+    # top-level outputs removed by alias elimination (e.g. ``y == some.state``) stay outputs
+    top_decls = {n: s.decl for n, s in getattr(compiled.source, "_symbols", {}).items()}
+    declared_outputs += [n for n, d in top_decls.items()
+                         if d.kind == KIND_OUTPUT and n in flat.aliases
+                         and flat.aliases[n][0] in dae.observed_index]
     states = set(dae.state_names)
     output_names = [n for n in declared_outputs if n not in states]
     taken = states | set(output_names)
     local_names = [n for n in dae.names if by_name[n].der_of < 0 and n not in taken]
     alias_names = [a for a, (rep, _) in sorted(flat.aliases.items())
                    if rep in dae.observed_index and by_name[rep].der_of < 0
-                   and not a.startswith("der(")]
-    y_sx = ca.vertcat(*[dae.observed[dae.observed_index[n]] for n in output_names + local_names],
-                      *[flat.aliases[a][1] * dae.observed[dae.observed_index[flat.aliases[a][0]]]
-                        for a in alias_names])
+                   and not a.startswith("der(") and a not in taken]
+
+    def observed(n: str) -> ca.SX:
+        # a declared output may be an alias (e.g. of a state): export it as an output anyway
+        if n in dae.observed_index:
+            return dae.observed[dae.observed_index[n]]
+        rep, sign = flat.aliases[n]
+        return sign * dae.observed[dae.observed_index[rep]]
+
+    y_sx = ca.vertcat(*[observed(n) for n in output_names + local_names + alias_names])
     f_sx = ca.Function("model", [dae.t, dae.x, dae.z, dae.p], [dae.ode, y_sx])
     if dae.z.numel():
         g = ca.Function("g", [dae.z, ca.vertcat(dae.t, dae.x, dae.p)], [dae.alg])
@@ -67,7 +78,7 @@ def fmu_spec(model: Component | CompiledModel, *, stop_time: float = 1.0,
 
     def scalar(name: str, start: float) -> ScalarVariable:
         v = by_name.get(name)
-        decl = v.decl if v is not None else None
+        decl = v.decl if v is not None else top_decls.get(name)
         return ScalarVariable(name, float(start), getattr(decl, "unit", "") or "",
                               getattr(decl, "description", "") or "")
 
