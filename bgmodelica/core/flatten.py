@@ -219,8 +219,9 @@ class _Flattener:
                     rows.append(k)
                     cols.append(self.pos[id(sym)])
                     vals.append(sgn)
-            sel = ca.DM(ca.Sparsity.triplet(len(pairs.sums), self.all_sx.numel(), rows, cols),
-                        vals)
+            # DM.triplet keeps each value with its (row, col); DM(Sparsity.triplet(...), vals)
+            # would not (the sparsity is sorted column-major)
+            sel = ca.DM.triplet(rows, cols, ca.DM(vals), len(pairs.sums), self.all_sx.numel())
             totals = ca.mtimes(sel, self.all_sx)
             parts = ca.vertsplit(totals) if len(pairs.sums) > 1 else [totals]
             for total, (_, _, origin) in zip(parts, pairs.sums, strict=True):

@@ -88,8 +88,11 @@ def reduce_index(model: FlatModel | ReducedModel,
         res = time_derivative(src.residual, [variables[j].sx for j in vs],
                               [variables[variables[j].der].sx for j in vs], TIME.sx)
         equations.append(FlatEquation(res, f"d/dt of {src.origin}"))
-        rows.append(incidence([res], [variables[j].sx for j in range(len(variables))])[0]
-                    if res.numel() else [])
+        rows.append(sorted(set(vs) | {variables[j].der for j in vs}))   # superset for now
+    n_old = len(eq_vars)
+    if len(equations) > n_old:                 # exact incidence of all new equations at once
+        rows[n_old:] = incidence([e.residual for e in equations[n_old:]],
+                                 [v.sx for v in variables])
     aug = FlatModel(model.name, variables, model.parameters, model.inputs, equations,
                     model.aliases)
     eq_derivative = (links + [-1] * (len(equations) - len(links))) if links \

@@ -1,0 +1,229 @@
+"""Consistency checks of a co-simulation set-up against its FMUs, and the direct-feedthrough
+graph that orders the evaluation of outputs at a communication point.
+
+:func:`check_system` raises (all :class:`~bgmodelica.errors.ModelError`):
+
+* :class:`~.errors.UnknownConnectorError` -- a connection or parameter binding names an
+  element, connector or parameter that does not exist;
+* :class:`~.errors.ConnectorMismatchError` -- a connection from something that is not an
+  output, to something that is not an input, between different types or incompatible units,
+  an input driven twice, or a connector declared in the SSD that contradicts the FMU;
+* :class:`~.errors.UnconnectedInputError` -- inputs no connection drives (all listed);
+* :class:`~.errors.AlgebraicLoopError` -- a cycle through direct feedthrough: the outputs of
+  the FMUs' ``<ModelStructure>`` declare on which inputs they depend *directly*; following
+  connections and these dependencies around a loop means the coupled outputs at one instant
+  depend on themselves. The message names the connectors along the cycle.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..fmi.units import parse_unit
+from .errors import (
+    AlgebraicLoopError,
+    ConnectorMismatchError,
+    UnconnectedInputError,
+    UnknownConnectorError,
+)
+from .fmu import FmuInfo
+from .ssp import SystemStructure
+
+
+@dataclass
+class Plan:
+    """What the master needs from a checked system.
+
+    ``inputs[el]``/``outputs[el]``: connector names per element (FMU inputs; FMU outputs used
+    by a connection, then the other outputs); ``sources[(el, input)] = (el, output)``;
+    ``order``: every connector node ``(el, name, is_output)`` in an order where each output
+    comes after the inputs it depends on directly and each input after its source output.
+    """
+
+    inputs: dict[str, list[str]]
+    outputs: dict[str, list[str]]
+    sources: dict[tuple[str, str], tuple[str, str]]
+    order: list[tuple[str, str, bool]]
+    feedthrough: dict[str, dict[str, list[str]]]
+    unconnected: list[str]
+
+
+def units_compatible(a: str, b: str) -> bool:
+    """Equal unit strings, or strings with the same base-unit exponents, factor and offset
+    (an empty unit is compatible with anything)."""
+    if not a or not b or a == b:
+        return True
+    da, db = parse_unit(a), parse_unit(b)
+    if da.exponents is None or db.exponents is None:
+        return False
+    return (da.exponents == db.exponents and abs(da.factor - db.factor) <= 1e-12 * abs(da.factor)
+            and da.offset == db.offset)
+
+
+def check_system(system: SystemStructure, infos: dict[str, FmuInfo],
+                 allow_unconnected: bool = False) -> Plan:
+    """Check ``system`` against the FMUs (``infos``: element -> :class:`FmuInfo`); return the
+    :class:`Plan` or raise (see the module docstring)."""
+    names = system.element_names
+    dup = {n for n in names if names.count(n) > 1}
+    if dup:
+        raise ConnectorMismatchError(f"element name(s) used twice: {', '.join(sorted(dup))}")
+    for comp in system.elements:
+        info = infos[comp.name]
+        for c in comp.connectors:
+            var = info.variables.get(c.name)
+            if var is None:
+                raise UnknownConnectorError(
+                    f"connector {comp.name}.{c.name} of the SSD does not exist in "
+                    f"{info.path.name}")
+            if c.kind in ("input", "output", "parameter") and var.causality != c.kind:
+                raise ConnectorMismatchError(
+                    f"connector {comp.name}.{c.name} is declared as {c.kind} in the SSD but "
+                    f"is a {var.causality} of {info.path.name}")
+            if c.type != var.type:
+                raise ConnectorMismatchError(
+                    f"connector {comp.name}.{c.name} is declared {c.type} in the SSD but is "
+                    f"{var.type} in {info.path.name}")
+            if not units_compatible(c.unit, var.unit):
+                raise ConnectorMismatchError(
+                    f"connector {comp.name}.{c.name} has unit {c.unit!r} in the SSD but "
+                    f"{var.unit!r} in {info.path.name}")
+        for pname in comp.parameters:
+            var = info.variables.get(pname)
+            if var is None:
+                raise UnknownConnectorError(
+                    f"parameter binding {comp.name}.{pname}: {info.path.name} has no variable "
+                    f"{pname!r}")
+            if var.causality not in ("parameter", "input") or var.type != "Real":
+                raise ConnectorMismatchError(
+                    f"parameter binding {comp.name}.{pname}: it is a {var.causality} "
+                    f"{var.type} of {info.path.name}, not a real parameter")
+
+    sources: dict[tuple[str, str], tuple[str, str]] = {}
+    used_outputs: dict[str, list[str]] = {n: [] for n in names}
+    for con in system.connections:
+        for el in (con.start_element, con.end_element):
+            if el not in infos:
+                raise UnknownConnectorError(
+                    f"connection {con}: there is no element {el!r} (elements: "
+                    f"{', '.join(names)})")
+        a = infos[con.start_element].variables.get(con.start_connector)
+        b = infos[con.end_element].variables.get(con.end_connector)
+        for var, full, el in ((a, con.start, con.start_element),
+                              (b, con.end, con.end_element)):
+            if var is None:
+                info = infos[el]
+                choices = [v.name for v in info.inputs + info.outputs]
+                raise UnknownConnectorError(
+                    f"connection {con}: {full} does not exist ({info.path.name} has inputs/"
+                    f"outputs {', '.join(choices) or 'none'})")
+        assert a is not None and b is not None
+        if a.causality != "output":
+            raise ConnectorMismatchError(
+                f"connection {con}: {con.start} is a {a.causality}, not an output")
+        if b.causality != "input":
+            raise ConnectorMismatchError(
+                f"connection {con}: {con.end} is a {b.causality}, not an input")
+        if a.type != b.type:
+            raise ConnectorMismatchError(
+                f"connection {con}: type mismatch, {con.start} is {a.type} and {con.end} is "
+                f"{b.type}")
+        if a.type != "Real":
+            raise ConnectorMismatchError(
+                f"connection {con}: only Real connectors are supported, not {a.type}")
+        if not units_compatible(a.unit, b.unit):
+            raise ConnectorMismatchError(
+                f"connection {con}: unit mismatch, {con.start} is in {a.unit!r} and "
+                f"{con.end} in {b.unit!r}")
+        key = (con.end_element, con.end_connector)
+        if key in sources:
+            other = "{}.{}".format(*sources[key])
+            raise ConnectorMismatchError(
+                f"input {con.end} is driven twice: by {other} and by {con.start}")
+        sources[key] = (con.start_element, con.start_connector)
+        if con.start_connector not in used_outputs[con.start_element]:
+            used_outputs[con.start_element].append(con.start_connector)
+
+    inputs = {n: [v.name for v in infos[n].inputs] for n in names}
+    unconnected = [f"{n}.{u}" for n in names for u in inputs[n] if (n, u) not in sources]
+    if unconnected and not allow_unconnected:
+        raise UnconnectedInputError(
+            f"input(s) not connected to any output: {', '.join(unconnected)} (connect them, "
+            "or give them values as parameters of the set-up)", unconnected)
+    outputs = {n: used_outputs[n] + [v.name for v in infos[n].outputs
+                                     if v.name not in used_outputs[n]] for n in names}
+    feed = {n: infos[n].feedthrough for n in names}
+    order = _evaluation_order(names, inputs, outputs, sources, feed)
+    return Plan(inputs, outputs, sources, order, feed, unconnected)
+
+
+def _evaluation_order(names, inputs, outputs, sources, feed) -> list[tuple[str, str, bool]]:
+    """Topological order of the connector graph; raises AlgebraicLoopError on a cycle."""
+    nodes: list[tuple[str, str, bool]] = []
+    succ: dict[tuple[str, str, bool], list[tuple[str, str, bool]]] = {}
+    for n in names:
+        for u in inputs[n]:
+            nodes.append((n, u, False))
+        for y in outputs[n]:
+            nodes.append((n, y, True))
+    for node in nodes:
+        succ[node] = []
+    for (el, u), (src, y) in sources.items():
+        succ[(src, y, True)].append((el, u, False))
+    for n in names:
+        for y in outputs[n]:
+            for u in feed[n].get(y, []):
+                if (n, u, False) in succ:
+                    succ[(n, u, False)].append((n, y, True))
+    cycle = _find_cycle(nodes, succ)
+    if cycle:
+        path = []
+        for el, name, is_out in cycle + cycle[:1]:
+            path.append(f"{el}.{name}")
+        raise AlgebraicLoopError(
+            "algebraic loop between subsystems (direct feedthrough around a cycle): "
+            + " -> ".join(path) + "; break it with a state (e.g. a filter or an inertia) "
+            "in one subsystem, or move the loop into one FMU", [f"{e}.{c}" for e, c, _ in cycle])
+    # Kahn's algorithm, stable in the declaration order
+    indeg = {v: 0 for v in nodes}
+    for v in nodes:
+        for w in succ[v]:
+            indeg[w] += 1
+    ready = [v for v in nodes if indeg[v] == 0]
+    order = []
+    while ready:
+        v = ready.pop(0)
+        order.append(v)
+        for w in succ[v]:
+            indeg[w] -= 1
+            if indeg[w] == 0:
+                ready.append(w)
+    return order
+
+
+def _find_cycle(nodes, succ):
+    """One cycle of the directed graph (list of nodes) or [] (iterative DFS)."""
+    color = {v: 0 for v in nodes}           # 0 new, 1 on stack, 2 done
+    parent: dict = {}
+    for root in nodes:
+        if color[root]:
+            continue
+        stack = [(root, iter(succ[root]))]
+        color[root] = 1
+        while stack:
+            v, it = stack[-1]
+            for w in it:
+                if color[w] == 0:
+                    color[w] = 1
+                    parent[w] = v
+                    stack.append((w, iter(succ[w])))
+                    break
+                if color[w] == 1:               # back edge v -> w: cycle w ... v
+                    cycle = [v]
+                    while cycle[-1] != w:
+                        cycle.append(parent[cycle[-1]])
+                    return cycle[::-1]
+            else:
+                color[v] = 2
+                stack.pop()
+    return []

@@ -1,0 +1,328 @@
+"""A fixed-step co-simulation master for FMUs described by an SSP set-up.
+
+Macro step ``H`` (communication points ``t_k = t0 + k H``), two orders:
+
+* **Jacobi** (``order="jacobi"``): every unit steps from ``t_k`` with the coupling values of
+  ``t_k``; units are independent within a step.
+* **Gauss-Seidel** (``order="gauss-seidel"``): units step one after the other (``sequence``,
+  default: the order of the elements in the SSD); a unit uses the ``t_{k+1}`` outputs of the
+  units already stepped and the ``t_k`` outputs of the others.
+
+Inputs over a step are ``u(t) = u0 + slope (t - t_k)``:
+
+* no extrapolation: ``slope = 0``, ``u0`` = the newest coupling value (zero-order hold);
+* ``extrapolation=True``: linear. From a unit not yet stepped (always in Jacobi) the line
+  through the values at ``t_{k-1}`` and ``t_k`` (*extrapolation*); from a unit already stepped
+  in Gauss-Seidel the line through its values at ``t_k`` and ``t_{k+1}`` (*interpolation*).
+  Model Exchange units follow the ramp; Co-Simulation units hold its mean over the step
+  (``u0 + slope H/2``, the same integral: second order for integrated quantities).
+
+Outputs with direct feedthrough (from the FMUs' ``<ModelStructure>``): with
+``propagate=True`` (default) the master evaluates, at every communication point, the
+outputs in the topological order of the feedthrough graph after setting the exact coupling
+values of that instant, so recorded and coupled values are consistent (``y = g(x, u)`` at
+``t_k``). With ``propagate=False`` the outputs are those read right after ``doStep`` (with the
+inputs held during the step), as simple masters (and ``fmucontainer``) do.
+
+Units: Co-Simulation FMUs (``interface="cs"``, their own solver via ``doStep``) or Model
+Exchange FMUs integrated here (``"me"``: SciPy Radau per macro step); per element with a dict.
+
+Results: :class:`bgmodelica.Result` with ``<element>.<variable>`` names: every connector
+(inputs: the coupled value at the communication point) and any variable asked for in
+``record``; bound parameters are in ``result.parameters``; ``result.meta`` has the options
+and wall-clock times.
+"""
+
+from __future__ import annotations
+
+import math
+import time as _time
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..result import Result
+from .checks import Plan, check_system
+from .errors import CosimStepError, SetupError
+from .fmu import FmuInfo, make_unit, read_fmu_info
+from .ssp import SystemStructure, read_ssp
+
+ORDERS = ("jacobi", "gauss-seidel")
+
+
+def _norm_order(order: str) -> str:
+    o = order.lower().replace("_", "-")
+    if o in ("gs", "gauss-seidel", "gaussseidel", "seidel", "sequential"):
+        return "gauss-seidel"
+    if o in ("jacobi", "parallel"):
+        return "jacobi"
+    raise SetupError(f"order must be 'jacobi' or 'gauss-seidel', not {order!r}")
+
+
+class Master:
+    """Co-simulation of ``system`` (a :class:`~.ssp.SystemStructure` or the path of an
+    ``.ssp``). The set-up is checked at construction (see :mod:`.checks`).
+
+    ``interface``: ``"cs"`` (default), ``"me"``, ``"auto"`` (the SSD ``implementation``
+    attribute, else CS when available) or a dict element -> interface.
+    ``allow_unconnected``: keep unconnected inputs at their start values instead of raising.
+    ``me_rtol``/``me_atol``: tolerances of the Model Exchange integrator.
+    """
+
+    def __init__(self, system: SystemStructure | str | Path, *,
+                 interface: str | Mapping[str, str] = "cs", allow_unconnected: bool = False,
+                 me_rtol: float = 1e-8, me_atol: float = 1e-10) -> None:
+        if not isinstance(system, SystemStructure):
+            system = read_ssp(system)
+        self.system = system
+        self.infos: dict[str, FmuInfo] = {}
+        for comp in system.elements:
+            if comp.fmu_path is None:
+                raise SetupError(f"element {comp.name!r}: FMU file unknown (source "
+                                 f"{comp.source!r})")
+            self.infos[comp.name] = read_fmu_info(comp.fmu_path)
+        self.plan: Plan = check_system(system, self.infos, allow_unconnected)
+        self.interfaces = {c.name: self._interface(c.name, c.implementation, interface)
+                           for c in system.elements}
+        self.me_rtol, self.me_atol = me_rtol, me_atol
+
+    def _interface(self, name: str, implementation: str, wanted: Any) -> str:
+        info = self.infos[name]
+        if isinstance(wanted, Mapping):
+            wanted = wanted.get(name, "cs")
+        if wanted == "auto":
+            if implementation == "ModelExchange" and info.me_identifier:
+                return "me"
+            return "cs" if info.cs_identifier else "me"
+        if wanted not in ("cs", "me"):
+            raise SetupError(f"interface must be 'cs', 'me' or 'auto', not {wanted!r}")
+        if wanted == "cs" and not info.cs_identifier:
+            raise SetupError(f"element {name!r}: {info.path.name} has no Co-Simulation "
+                             "interface (use interface='me')")
+        if wanted == "me" and not info.me_identifier:
+            raise SetupError(f"element {name!r}: {info.path.name} has no Model Exchange "
+                             "interface (use interface='cs')")
+        return wanted
+
+    # ------------------------------------------------------------------------------------
+    def simulate(self, stop_time: float | None = None, step: float | None = None, *,
+                 order: str = "jacobi", extrapolation: bool = False, propagate: bool = True,
+                 start_time: float | None = None, sequence: Sequence[str] | None = None,
+                 parameters: Mapping[str, Mapping[str, float]] | None = None,
+                 record: Iterable[str] = (), tolerance: float | None = None,
+                 record_every: int = 1) -> Result:
+        """Run the co-simulation and return the :class:`~bgmodelica.Result`.
+
+        ``stop_time``/``step``: default from the SSD (DefaultExperiment, the master
+        annotation's ``step_size``; else 1e-3 s). ``parameters``: element -> {name: value}
+        on top of the SSD bindings. ``record``: extra variables ``element.variable``.
+        ``tolerance``: passed to the FMUs' ``setupExperiment`` (None: not defined).
+        ``record_every``: keep every n-th communication point (the last one always).
+        """
+        system = self.system
+        order = _norm_order(order)
+        t0 = float(system.start_time if start_time is None else start_time)
+        t_end = stop_time if stop_time is not None else system.stop_time
+        if t_end is None:
+            raise SetupError("no stop time: give stop_time or set the SSD DefaultExperiment")
+        h = float(step if step is not None else system.master.get("step_size", 1e-3))
+        if not (h > 0 and math.isfinite(h)):
+            raise SetupError(f"macro step must be > 0, got {h}")
+        span = float(t_end) - t0
+        if span <= 0:
+            raise SetupError(f"stop time {t_end} must be after the start time {t0}")
+        n_steps = int(round(span / h))
+        if n_steps < 1 or abs(n_steps * h - span) > 1e-9 * max(1.0, span):
+            raise SetupError(f"the horizon {span:g} s is not a multiple of the macro step "
+                             f"{h:g} s")
+        names = system.element_names
+        seq = list(sequence) if sequence is not None else list(names)
+        if sorted(seq) != sorted(names):
+            raise SetupError(f"sequence {seq} must list every element once ({names})")
+        plan = self.plan
+        params = {c.name: dict(c.parameters) for c in system.elements}
+        for el, vals in (parameters or {}).items():
+            if el not in params:
+                raise SetupError(f"parameters for unknown element {el!r}")
+            for p in vals:
+                if p not in self.infos[el].variables:
+                    raise SetupError(f"element {el!r} has no variable {p!r}")
+            params[el].update({k: float(v) for k, v in vals.items()})
+        extra: dict[str, list[str]] = {n: [] for n in names}
+        for full in record:
+            el, _, var = full.partition(".")
+            if el not in extra or not var:
+                raise SetupError(f"record: {full!r} is not <element>.<variable>")
+            self.infos[el].variable(var, el)
+            extra[el].append(var)
+
+        # index tables -------------------------------------------------------------------
+        out_pos = {n: {y: k for k, y in enumerate(plan.outputs[n])} for n in names}
+        src_index: dict[str, list[tuple[str, int] | None]] = {}
+        start_u: dict[str, np.ndarray] = {}
+        for n in names:
+            src_index[n] = []
+            su = []
+            for u in plan.inputs[n]:
+                s = plan.sources.get((n, u))
+                src_index[n].append(None if s is None else (s[0], out_pos[s[0]][s[1]]))
+                var = self.infos[n].variables[u]
+                su.append(params[n].get(u, var.start if var.start is not None else 0.0))
+            start_u[n] = np.array(su, dtype=float)
+        has_feed = {n: any(plan.feedthrough[n].get(y) for y in plan.outputs[n])
+                    for n in names}
+
+        units = {}
+        wall0 = _time.perf_counter()
+        try:
+            for comp in system.elements:
+                n = comp.name
+                unit = make_unit(n, self.infos[n], self.interfaces[n], plan.inputs[n],
+                                 plan.outputs[n], rtol=self.me_rtol, atol=self.me_atol)
+                units[n] = unit
+                pset = {k: v for k, v in params[n].items()
+                        if self.infos[n].variables[k].causality == "parameter"}
+                unit.setup(t0, float(t_end), pset, start_u[n], tolerance)
+            y = {n: units[n].get_outputs() for n in names}
+            last_set = {n: start_u[n].copy() for n in names}
+
+            def coupled(n: str, ys: dict[str, np.ndarray]) -> np.ndarray:
+                u = start_u[n].copy()
+                for j, s in enumerate(src_index[n]):
+                    if s is not None:
+                        u[j] = ys[s[0]][s[1]]
+                return u
+
+            def propagate_outputs() -> None:
+                for el, _, is_out in plan.order:
+                    if not is_out or not has_feed[el]:
+                        continue
+                    u = coupled(el, y)
+                    if not np.array_equal(u, last_set[el]):
+                        units[el].set_inputs(u)
+                        last_set[el] = u
+                        y[el] = units[el].get_outputs()
+
+            if propagate:
+                propagate_outputs()
+            wall_setup = _time.perf_counter() - wall0
+
+            # recording ------------------------------------------------------------------
+            cols: list[str] = []
+            for n in names:
+                cols += [f"{n}.{u}" for u in plan.inputs[n]]
+                cols += [f"{n}.{v}" for v in plan.outputs[n]]
+                cols += [f"{n}.{v}" for v in extra[n]]
+            keep = list(range(0, n_steps + 1, max(1, int(record_every))))
+            if keep[-1] != n_steps:
+                keep.append(n_steps)
+            keep_set = set(keep)
+            data = np.empty((len(keep), len(cols)))
+            times = np.empty(len(keep))
+            row = 0
+
+            def record_point(k: int, t: float) -> None:
+                nonlocal row
+                if k not in keep_set:
+                    return
+                parts = []
+                for n in names:
+                    parts.append(coupled(n, y))
+                    parts.append(y[n])
+                    if extra[n]:
+                        parts.append(units[n].get(extra[n]))
+                data[row] = np.concatenate(parts) if parts else []
+                times[row] = t
+                row += 1
+
+            record_point(0, t0)
+            u_prev: dict[str, np.ndarray] | None = None
+            wall1 = _time.perf_counter()
+            for k in range(n_steps):
+                t = t0 + k * h
+                u_now = {n: coupled(n, y) for n in names}
+                if order == "jacobi":
+                    for n in names:
+                        slope = None
+                        if extrapolation and u_prev is not None and len(u_now[n]):
+                            slope = (u_now[n] - u_prev[n]) / h
+                        units[n].step(t, h, u_now[n], slope)
+                        last_set[n] = u_now[n] if slope is None else None
+                    y = {n: units[n].get_outputs() for n in names}
+                else:
+                    y_old = dict(y)
+                    stepped: set[str] = set()
+                    for n in seq:
+                        u0 = u_now[n].copy()
+                        slope = np.zeros_like(u0) if extrapolation else None
+                        for j, s in enumerate(src_index[n]):
+                            if s is None:
+                                continue
+                            if s[0] in stepped:
+                                new, old = y[s[0]][s[1]], y_old[s[0]][s[1]]
+                                if extrapolation:
+                                    u0[j], slope[j] = old, (new - old) / h
+                                else:
+                                    u0[j] = new
+                            elif extrapolation and u_prev is not None:
+                                slope[j] = (u_now[n][j] - u_prev[n][j]) / h
+                        units[n].step(t, h, u0, slope)
+                        last_set[n] = u0 if slope is None else None
+                        y[n] = units[n].get_outputs()
+                        if propagate and has_feed[n]:
+                            u = coupled(n, y)
+                            units[n].set_inputs(u)
+                            last_set[n] = u
+                            y[n] = units[n].get_outputs()
+                        stepped.add(n)
+                for n in names:
+                    if last_set[n] is None:
+                        last_set[n] = np.full(len(u_now[n]), np.nan)
+                if propagate:
+                    propagate_outputs()
+                u_prev = u_now
+                for n in names:
+                    if not np.all(np.isfinite(y[n])):
+                        bad = [plan.outputs[n][i] for i in np.flatnonzero(~np.isfinite(y[n]))]
+                        raise CosimStepError(
+                            f"element {n!r}: output(s) {', '.join(bad)} not finite at "
+                            f"t={t + h:g} (the coupling may be unstable at macro step {h:g} s)",
+                            n, t + h)
+                record_point(k + 1, t0 + (k + 1) * h)
+            wall_run = _time.perf_counter() - wall1
+        finally:
+            for unit in units.values():
+                unit.terminate()
+
+        parameters_out = {}
+        for n in names:
+            for v in self.infos[n].parameters:
+                if v.type == "Real":
+                    val = params[n].get(v.name, v.start)
+                    if val is not None:
+                        parameters_out[f"{n}.{v.name}"] = float(val)
+        units_of = {}
+        for n in names:
+            for v in plan.inputs[n] + plan.outputs[n] + extra[n]:
+                units_of[f"{n}.{v}"] = self.infos[n].variables[v].unit
+        meta = {
+            "master": "bgmodelica.cosim", "order": order, "extrapolation": bool(extrapolation),
+            "propagate": bool(propagate), "step": h, "steps": n_steps, "start_time": t0,
+            "stop_time": float(t_end), "interfaces": dict(self.interfaces),
+            "sequence": seq if order == "gauss-seidel" else None,
+            "setup_seconds": wall_setup, "run_seconds": wall_run,
+            "seconds_per_simulated_second": wall_run / span,
+            "me_rhs_evaluations": {n: getattr(u, "n_rhs", None) for n, u in units.items()
+                                   if self.interfaces[n] == "me"},
+        }
+        return Result(times[:row], data[:row], cols, parameters=parameters_out, units=units_of,
+                      meta=meta)
+
+
+def cosimulate(system: SystemStructure | str | Path, stop_time: float | None = None,
+               step: float | None = None, *, interface: str | Mapping[str, str] = "cs",
+               **options: Any) -> Result:
+    """One-call form: ``Master(system, interface=...).simulate(stop_time, step, **options)``."""
+    return Master(system, interface=interface).simulate(stop_time, step, **options)
