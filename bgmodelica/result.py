@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import csv
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -16,11 +16,12 @@ class Result:
     """Trajectories of a simulation.
 
     time: [s], shape (N,). ``result["motor.R.i"]`` gives a variable (aliases and parameters
-    included). ``meta`` holds solver statistics and compile/run times [s].
+    included). ``meta`` holds solver statistics and compile/run times [s]. The variables
+    other than the states are computed from the trajectory when first asked for.
     """
 
     time: np.ndarray
-    values: np.ndarray                      # (N, len(names))
+    data: np.ndarray | Callable[[], np.ndarray]   # (N, len(names)), or computes it on demand
     names: list[str]
     aliases: dict[str, tuple[str, float]] = field(default_factory=dict)
     parameters: dict[str, float] = field(default_factory=dict)
@@ -29,6 +30,13 @@ class Result:
 
     def __post_init__(self) -> None:
         self._index = {n: k for k, n in enumerate(self.names)}
+
+    @property
+    def values(self) -> np.ndarray:
+        """All recorded variables, shape (N, len(names)); evaluated on first use."""
+        if callable(self.data):
+            self.data = self.data()
+        return self.data
 
     def __contains__(self, name: str) -> bool:
         return name in self._index or name in self.aliases or name in self.parameters

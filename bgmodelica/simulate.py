@@ -60,7 +60,6 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
     grid = np.linspace(start_time, stop_time, n_int + 1)
     init = initialize(dae, p, start_time)
     obs_idx = _output_indices(dae, outputs, compiled.reduced.model.aliases)
-    observe = _observer(dae, obs_idx)
     opts = {"abstol": atol, "reltol": rtol, "max_num_steps": max_steps,
             "calc_ic": False}   # initialize() already made x0, z0 consistent
     if max_step is not None:
@@ -75,8 +74,8 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
         xs, zs, stats, failure = _integrate(dae, solver, grid, init.x0, init.z0, p, opts,
                                             progress)
         n_ok = xs.shape[1]
-        values = (np.asarray(observe(grid[:n_ok], xs, zs, p)) if n_ok
-                  else np.zeros((0, len(obs_idx))))
+        values = ((lambda: np.asarray(_observer(dae, obs_idx)(grid[:n_ok], xs, zs, p)))
+                  if n_ok else np.zeros((0, len(obs_idx))))
     run = _time.perf_counter() - t_start
     names = [dae.names[k] for k in obs_idx]
     flat = compiled.reduced.model
@@ -138,7 +137,14 @@ def _output_indices(dae: CasadiDAE, outputs: Sequence[str] | None,
 
 def _observer(dae: CasadiDAE, idx: list[int]) -> Callable:
     """Evaluate the observed variables ``idx`` on a grid, reading only the states and
-    algebraic variables they depend on."""
+    algebraic variables they depend on (built once per model and output set)."""
+    key = ("observer", tuple(idx))
+    if key not in dae.cache:
+        dae.cache[key] = _make_observer(dae, idx)
+    return dae.cache[key]
+
+
+def _make_observer(dae: CasadiDAE, idx: list[int]) -> Callable:
     expr = ca.vertcat(*[dae.observed[k] for k in idx]) if idx else ca.SX(0, 1)
     used_x = sorted(set(ca.jacobian_sparsity(expr, dae.x).get_triplet()[1])) \
         if dae.x.numel() else []
@@ -176,7 +182,9 @@ def _integrator(dae: CasadiDAE, solver: str, t0: float, tout: np.ndarray, opts: 
 
 def _xdot(dae: CasadiDAE, t: float, x, z, p) -> list[float]:
     """Consistent initial state derivative for IDAS (we skip IDACalcIC: x0, z0 are solved)."""
-    f = ca.Function("xdot0", [dae.t, dae.x, dae.z, dae.p], [dae.ode])
+    if "xdot" not in dae.cache:
+        dae.cache["xdot"] = ca.Function("xdot0", [dae.t, dae.x, dae.z, dae.p], [dae.ode])
+    f = dae.cache["xdot"]
     return [float(v) for v in np.asarray(f(t, x, z, p)).ravel()]
 
 

@@ -7,7 +7,7 @@ interval). Parameters bound to expressions of other parameters are substituted a
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
@@ -42,6 +42,7 @@ class CasadiDAE:
     z_start: np.ndarray
     fixed: list[tuple[int, float]]          # (index in names, value) of fixed start values
     observed_index: dict[str, int]
+    cache: dict = field(default_factory=dict, repr=False)   # CasADi functions built on demand
 
     @property
     def p_default(self) -> np.ndarray:
