@@ -16,10 +16,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+from rc_ladder import rc_ladder  # noqa: E402
+
 import bgmodelica as bg  # noqa: E402
 from bgmodelica import Component  # noqa: E402
 from library.rotational import Damper, Fixed, Inertia, Spring  # noqa: E402
-from rc_ladder import rc_ladder  # noqa: E402
 
 
 def inertia_chain(n: int) -> Component:

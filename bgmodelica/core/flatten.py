@@ -295,7 +295,7 @@ class _Flattener:
         rhs = lower_group(shape_r, leaf_vecs[n_l:], const_vecs[c_l:])
         res = ca.SX(lhs - rhs)
         parts = ca.vertsplit(res) if len(members) > 1 else [res]
-        for r, (leaves, _, where, eq) in zip(parts, members, strict=True):
+        for r, (_, _, where, eq) in zip(parts, members, strict=True):
             self.equations.append(FlatEquation(r, where, self._alias(eq)))
 
     def _alias(self, eq: Equation) -> tuple[int, int, float] | None:

@@ -31,7 +31,7 @@ class BalanceReport:
 def base_of(model: FlatModel) -> list[int]:
     """For each variable, the index of the variable it is a derivative of (itself if none)."""
     base = list(range(len(model.variables)))
-    for i, v in enumerate(model.variables):
+    for i in range(len(model.variables)):
         j = i
         while model.variables[j].der_of >= 0:
             j = model.variables[j].der_of
