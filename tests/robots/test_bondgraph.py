@@ -46,12 +46,13 @@ def test_motor_matches_bond_graph_motor():
 
 @pytest.mark.parametrize("start", [(0.3, -0.5, 0.0, 0.0), (-1.0, 1.5, -2.0, 3.0)])
 def test_free_arm_matches_bond_graph_arm(start):
-    """3 s free swings of the multibody arm and of the bond-graph arm (Fig. 9/11)."""
+    """5 s free swings of the multibody arm and of the bond-graph arm (Fig. 9/11); the
+    chaotic double pendulum needs rtol 1e-13 for the two routes to agree to 1e-8."""
     q1, q2, w1, w2 = start
     out = {}
     for key, make in (("mb", TwoLinkArm), ("bg", bond_graph_arm)):
-        res = simulate(compile(make(q1=q1, q2=q2, w1=w1, w2=w2)), stop_time=3.0,
-                       interval=0.01, **TIGHT)
+        res = simulate(compile(make(q1=q1, q2=q2, w1=w1, w2=w2)), stop_time=5.0,
+                       interval=0.01, rtol=1e-13, atol=1e-15, dynamic=False)
         out[key] = np.column_stack([res[n] for n in ("q1", "q2", "w1", "w2")])
     dev = np.max(np.abs(out["mb"] - out["bg"]), axis=0)
     assert np.all(dev[:2] < 1e-8), dev
