@@ -4,10 +4,7 @@ reduction -> BLT/tearing -> CasADi DAE. Each stage is a function of the previous
 
 from __future__ import annotations
 
-import gc
 import time as _time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -20,6 +17,7 @@ from .passes.alias import eliminate_aliases
 from .passes.balance import BalanceReport, check_balance
 from .passes.index_reduction import ReducedModel, Selector, reduce_index
 from .passes.sorting import SortedDAE, sort_equations
+from .structure.graph import gc_paused
 
 
 @dataclass
@@ -68,22 +66,12 @@ class CompiledModel:
 
 
 def compile(model: Component, *, select: Selector | None = None) -> CompiledModel:  # noqa: A001
-    """Compile a component tree into a :class:`CompiledModel`."""
+    """Compile a component tree into a :class:`CompiledModel`.
+
+    The cyclic garbage collector is paused meanwhile: compilation allocates millions of
+    objects that live until the end, and rescanning them costs more than it frees."""
     with gc_paused():
         return _compile(model, select)
-
-
-@contextmanager
-def gc_paused() -> Iterator[None]:
-    """Pause Python's cyclic garbage collector (compilation allocates millions of objects
-    that live until the end; scanning them repeatedly costs more than it frees)."""
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if enabled:
-            gc.enable()
 
 
 def _compile(model: Component, select: Selector | None) -> CompiledModel:
