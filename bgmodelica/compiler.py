@@ -38,6 +38,14 @@ class CompiledModel:
     def compile_time(self) -> float:
         return sum(self.timings.values())
 
+    def needs_dynamic_selection(self) -> bool:
+        """Whether simulation must be ready to change the states (their pivots vary)."""
+        if not self.reduced.has_choice:
+            return False
+        from .dynamic_selection import StateSelector
+
+        return StateSelector(self).needed()
+
     def summary(self) -> dict[str, Any]:
         """Counts and structure, as shown by ``bgmodelica check``."""
         red, srt = self.reduced, self.sorted
@@ -58,7 +66,7 @@ class CompiledModel:
             "algebraic_variables": [var[j].name for j in srt.algebraic],
             "algebraic_loops": [{"size": b.size, "kind": b.kind, "tearing": b.tear,
                                  "variables": b.variables[:8]} for b in loops],
-            "dynamic_state_selection": red.has_choice,
+            "dynamic_state_selection": self.needs_dynamic_selection(),
             "parameters": len(self.dae.parameters),
             "inputs": [u.name for u in self.dae.inputs],
             "compile_seconds": dict(self.timings),

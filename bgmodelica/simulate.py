@@ -232,6 +232,7 @@ def _integrate(dae: CasadiDAE, solver: str, grid: np.ndarray, x0, z0, p, opts, p
 
 
 def _selector(compiled: CompiledModel):
+    """The dynamic state selector of a model that needs one (cached on the model), or None."""
     if not compiled.reduced.has_choice:
         return None
     from .dynamic_selection import StateSelector
