@@ -68,7 +68,7 @@ class StateSelector:
         for _ in range(samples):
             jac = np.asarray(ca.DM(self._jac(rng.uniform(-2.0, 2.0, n), p, rng.uniform())))
             scores.append(self._score(jac, levels))
-        return max(scores) - min(scores) > 1e-9 * max(1.0, max(abs(v) for v in scores))
+        return bool(max(scores) - min(scores) > 1e-9 * max(1.0, max(abs(v) for v in scores)))
 
     def _score(self, jac: np.ndarray, levels) -> float:
         score = 1.0
