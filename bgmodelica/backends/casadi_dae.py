@@ -81,16 +81,13 @@ def build_dae(sorted_dae: SortedDAE) -> CasadiDAE:
     model = sorted_dae.model
     variables = model.variables
     states = sorted_dae.states
-    state_set = set(states)
     alg_vars = sorted_dae.algebraic
-    alg_set = set(alg_vars)
 
     free_params = [p for p in model.parameters if not isinstance(p.decl.value, ca.SX)]
     bound = [p for p in model.parameters if isinstance(p.decl.value, ca.SX)]
 
     vsym = [variables[j].sx for j, _ in sorted_dae.assignments]
     vdef = [d for _, d in sorted_dae.assignments]
-    assigned = {j: k for k, (j, _) in enumerate(sorted_dae.assignments)}
     # what we need in terms of knowns: state derivatives, residuals, every variable
     ode_raw = []
     for j in states:
@@ -109,7 +106,6 @@ def build_dae(sorted_dae: SortedDAE) -> CasadiDAE:
     ode = targets[:n_x]
     alg = targets[n_x:n_x + n_r]
     observed = targets[n_x + n_r:]
-    del assigned, state_set, alg_set
 
     names = [v.name for v in variables]
     observed_index = {n: k for k, n in enumerate(names)}

@@ -49,7 +49,8 @@ from ..core.variables import (
 )
 from ..errors import DeclarationError
 
-__all__ = ["FlowInput", "FlowOutput", "PotentialInput", "PotentialOutput", "expose"]
+__all__ = ["FlowInput", "FlowOutput", "PotentialInput", "PotentialOutput", "add_signal",
+           "expose"]
 
 
 @dataclass(frozen=True)
@@ -151,7 +152,10 @@ def _pick(conn: Connector, kind: str, wanted: str | None, path: str) -> str:
     return names[0]
 
 
-def _new_signal(component: Component, name: str, decl: Any) -> Any:
+def add_signal(component: Component, name: str, decl: Any) -> Any:
+    """Declare a new top-level signal ``name`` (an :class:`~bgmodelica.Input` or
+    :class:`~bgmodelica.Output` declaration) on the component instance; returns its leaf for
+    equations (``component.equation(leaf == ...)``)."""
     if not name.isidentifier():
         raise DeclarationError(f"{name!r} is not a valid signal name")
     if name in component._symbols or name in component._children:
@@ -185,7 +189,7 @@ def expose(component: Component, inputs: Mapping[str, Any] | None = None,
             target = _resolve(component, spec)
             if not isinstance(target, Symbol) or target.decl.kind != KIND_INPUT:
                 raise DeclarationError(f"input {name!r}: {spec!r} is not an Input variable")
-            leaf = _new_signal(component, name, Input(unit=target.decl.unit,
+            leaf = add_signal(component, name, Input(unit=target.decl.unit,
                                                       description=target.decl.description))
             component.connect(leaf, target.leaf)
             continue
@@ -213,9 +217,9 @@ def expose(component: Component, inputs: Mapping[str, Any] | None = None,
             port.modify(**{pot: dict(start=float(spec.start), fixed=bool(spec.fixed))})
         adapter = _Adapter(port, mode, pot, flow, order)
         component.add(f"{name}_source", adapter)
-        leaf = _new_signal(component, name, Input(unit=unit, description=(
-            f"{'Flow into' if mode == 'flow' else 'Imposed ' + ('rate of ' if order else '')}"
-            f" {spec.connector}.{flow if mode == 'flow' else pot}")))
+        what = (f"Flow into {spec.connector}.{flow}" if mode == "flow" else
+                f"Imposed {'rate of ' if order else ''}{spec.connector}.{pot}")
+        leaf = add_signal(component, name, Input(unit=unit, description=what))
         component.connect(adapter.port, conn)
         component.equation(*adapter.drive(leaf))
         adapters[id(conn)] = adapter
@@ -232,7 +236,7 @@ def expose(component: Component, inputs: Mapping[str, Any] | None = None,
             target = _resolve(component, spec)
             if not isinstance(target, Symbol):
                 raise DeclarationError(f"output {name!r}: {spec!r} is not a variable")
-            leaf = _new_signal(component, name, Output(unit=target.decl.unit,
+            leaf = add_signal(component, name, Output(unit=target.decl.unit,
                                                        description=target.decl.description))
             component.equation(leaf == target.leaf)
         elif isinstance(spec, PotentialOutput):
@@ -244,7 +248,7 @@ def expose(component: Component, inputs: Mapping[str, Any] | None = None,
                 value, unit = der(value), _der_unit(unit)
             elif spec.order != 0:
                 raise DeclarationError(f"output {name!r}: order must be 0 or 1")
-            leaf = _new_signal(component, name, Output(unit=unit, description=(
+            leaf = add_signal(component, name, Output(unit=unit, description=(
                 f"{'Rate of ' if spec.order else ''}{spec.connector}.{pot}")))
             component.equation(leaf == value)
         elif isinstance(spec, FlowOutput):
@@ -255,7 +259,7 @@ def expose(component: Component, inputs: Mapping[str, Any] | None = None,
                     f"output {name!r}: FlowOutput({spec.connector!r}) needs a PotentialInput "
                     "on the same connector (the flow is what it takes to impose the motion)")
             flow = adapter._mode[2]
-            leaf = _new_signal(component, name, Output(
+            leaf = add_signal(component, name, Output(
                 unit=conn._symbols[flow].decl.unit,
                 description=f"{flow} exerted by the component at {spec.connector}"))
             component.equation(leaf == getattr(adapter.port, flow))
