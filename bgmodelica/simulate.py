@@ -180,6 +180,18 @@ def _integrator(dae: CasadiDAE, solver: str, t0: float, tout: np.ndarray, opts: 
     return ca.integrator("sim", solver, problem, float(t0), list(map(float, tout)), opts)
 
 
+def _cached_integrator(dae: CasadiDAE, solver: str, t0: float, tout: np.ndarray, opts: dict):
+    """The integrator for these settings, reused by repeated runs of the same model."""
+    key = ("integrator", solver, float(t0), tuple(map(float, tout)),
+           tuple(sorted((k, tuple(v) if isinstance(v, list) else v) for k, v in opts.items())))
+    cache = dae.cache.setdefault("integrators", {})
+    if key not in cache:
+        if len(cache) >= 4:
+            cache.pop(next(iter(cache)))
+        cache[key] = _integrator(dae, solver, t0, tout, opts)
+    return cache[key]
+
+
 def _xdot(dae: CasadiDAE, t: float, x, z, p) -> list[float]:
     """Consistent initial state derivative for IDAS (we skip IDACalcIC: x0, z0 are solved)."""
     if "xdot" not in dae.cache:
@@ -208,7 +220,7 @@ def _integrate(dae: CasadiDAE, solver: str, grid: np.ndarray, x0, z0, p, opts, p
                 chunk_opts.pop("calc_ic", None)      # an IDAS-only option
             if solver == "idas" and dae.x.numel():
                 chunk_opts["init_xdot"] = _xdot(dae, chunk[0], xk, zk, p)
-            F = _integrator(dae, solver, chunk[0], chunk[1:], chunk_opts)
+            F = _cached_integrator(dae, solver, chunk[0], chunk[1:], chunk_opts)
             out = F(x0=xk, z0=zk, p=p)
         except RuntimeError as err:
             failure = str(err)
