@@ -198,6 +198,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 _EXTENSIONS: list = []
 
+from .cosim.cli import register as register_cosim  # noqa: E402
+
+_EXTENSIONS.append(register_cosim)
+
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()

@@ -54,14 +54,16 @@ def main(argv: list[str]) -> int:
               + ("OK" if rep["valid"] else "FAILED: " + "; ".join(rep["problems"]))
               + f" ({rep['seconds']} s)")
     summary["fmus"] = fmus
-    try:
-        from bgmodelica.cosim import verify_robot
-    except ImportError:
-        verify_robot = None
-    if verify_robot is not None:
-        report = verify_robot(out_dir=outdir)
-        print(report.to_text())
-        summary["verification"] = report.to_dict()
+    from bgmodelica.cosim import verify_robot
+    from library.robots.subsystems import export_robot_setup
+
+    setup = export_robot_setup(FMU_DIR)
+    print(f"co-simulation set-ups -> {setup['ssp']}, {setup['ssp_plain']}")
+    report = verify_robot(fmus={k: v for k, v in setup.items() if not k.startswith(("ssp",
+                                                                                   "container"))})
+    print(report.to_text())
+    report.plot(outdir / "verify.png")
+    summary["verification"] = report.to_dict()
     (outdir / "summary.json").write_text(json.dumps(summary, indent=2, default=str))
     print(f"summary -> {outdir / 'summary.json'}")
     failed = [n for n, r in fmus.items() if not r["valid"]]

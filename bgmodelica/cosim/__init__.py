@@ -1,3 +1,51 @@
-"""Co-simulation of FMUs: SSP set-ups, a fixed-step master (Jacobi / Gauss-Seidel, optional
-input extrapolation, Co-Simulation and Model Exchange FMUs), checks of the set-up, a
-cross-check against ``fmucontainer`` and the robot verification (monolithic vs split)."""
+"""Co-simulation of FMUs: SSP set-ups, a fixed-step master, checks, a cross-check against
+``fmucontainer`` and the verification of the split robot against the monolithic model.
+
+Modules:
+
+- :mod:`.wrap`: :func:`expose` turns an acausal component into a causal subsystem (connectors
+  driven by / returning top-level inputs and outputs) for FMU export;
+- :mod:`.ssp`: SSP 1.0 archives -- :func:`write_ssp`, :func:`read_ssp`,
+  :func:`system_from_fmus`, :class:`SystemStructure`;
+- :mod:`.fmu`: FMU model descriptions and fmpy-based Co-Simulation / Model Exchange units;
+- :mod:`.checks`: set-up checks (unconnected inputs, type/unit mismatches, algebraic loops);
+- :mod:`.master`: :class:`Master` / :func:`cosimulate` -- fixed macro step, Jacobi or
+  Gauss-Seidel, optional linear extrapolation, feedthrough propagation;
+- :mod:`.xcheck`: :func:`cross_check` against an ``fmucontainer`` container FMU;
+- :mod:`.verify`: :func:`verify_robot` -> :class:`VerifyReport` (the paper's PID robot);
+- :mod:`.cli`: the ``cosim`` and ``verify`` subcommands (:func:`~.cli.register`).
+
+Errors are :class:`bgmodelica.errors.ModelError` subclasses (:mod:`.errors`).
+"""
+
+from .errors import (
+    AlgebraicLoopError,
+    ConnectorMismatchError,
+    CosimError,
+    CosimStepError,
+    SetupError,
+    SspFormatError,
+    UnconnectedInputError,
+    UnknownConnectorError,
+)
+from .master import Master, cosimulate
+from .ssp import (
+    SspComponent,
+    SspConnection,
+    SspConnector,
+    SystemStructure,
+    read_ssp,
+    system_from_fmus,
+    write_ssp,
+)
+from .verify import VerifyReport, verify_robot
+from .wrap import FlowInput, FlowOutput, PotentialInput, PotentialOutput, add_signal, expose
+
+__all__ = [
+    "AlgebraicLoopError", "ConnectorMismatchError", "CosimError", "CosimStepError",
+    "SetupError", "SspFormatError", "UnconnectedInputError", "UnknownConnectorError",
+    "Master", "cosimulate", "SspComponent", "SspConnection", "SspConnector",
+    "SystemStructure", "read_ssp", "system_from_fmus", "write_ssp", "VerifyReport",
+    "verify_robot", "FlowInput", "FlowOutput", "PotentialInput", "PotentialOutput",
+    "add_signal", "expose",
+]

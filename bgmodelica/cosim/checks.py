@@ -149,7 +149,7 @@ def check_system(system: SystemStructure, infos: dict[str, FmuInfo],
     if unconnected and not allow_unconnected:
         raise UnconnectedInputError(
             f"input(s) not connected to any output: {', '.join(unconnected)} (connect them, "
-            "or give them values as parameters of the set-up)", unconnected)
+            "or allow_unconnected=True to keep their start values)", unconnected)
     outputs = {n: used_outputs[n] + [v.name for v in infos[n].outputs
                                      if v.name not in used_outputs[n]] for n in names}
     feed = {n: infos[n].feedthrough for n in names}
@@ -177,9 +177,7 @@ def _evaluation_order(names, inputs, outputs, sources, feed) -> list[tuple[str, 
                     succ[(n, u, False)].append((n, y, True))
     cycle = _find_cycle(nodes, succ)
     if cycle:
-        path = []
-        for el, name, is_out in cycle + cycle[:1]:
-            path.append(f"{el}.{name}")
+        path = [f"{el}.{name}" for el, name, _ in cycle + cycle[:1]]
         raise AlgebraicLoopError(
             "algebraic loop between subsystems (direct feedthrough around a cycle): "
             + " -> ".join(path) + "; break it with a state (e.g. a filter or an inertia) "

@@ -18,6 +18,7 @@ Only real-valued (Real / Float64) inputs and outputs are supported as connectors
 
 from __future__ import annotations
 
+import atexit
 import ctypes
 import math
 import shutil
@@ -137,19 +138,21 @@ class _Extracted:
     """Unzip each FMU once per process (shared by the instances of one FMU)."""
 
     def __init__(self) -> None:
-        self.dirs: dict[Path, Path] = {}
+        self.dirs: dict[tuple[Path, int, int], Path] = {}
         self.root: Path | None = None
 
     def get(self, path: Path) -> Path:
         path = path.resolve()
-        if path not in self.dirs:
+        st = path.stat()
+        key = (path, st.st_mtime_ns, st.st_size)     # a rebuilt FMU is unzipped again
+        if key not in self.dirs:
             if self.root is None:
                 self.root = Path(tempfile.mkdtemp(prefix="bgm_cosim_"))
             target = self.root / f"{len(self.dirs):02d}_{path.stem}"
             with zipfile.ZipFile(path) as zf:
                 zf.extractall(target)
-            self.dirs[path] = target
-        return self.dirs[path]
+            self.dirs[key] = target
+        return self.dirs[key]
 
     def cleanup(self) -> None:
         if self.root is not None:
@@ -159,6 +162,7 @@ class _Extracted:
 
 
 _EXTRACTED = _Extracted()
+atexit.register(_EXTRACTED.cleanup)
 
 
 class _Unit:
@@ -247,7 +251,7 @@ class _Unit:
             self.fmu = cls(guid=self.info.guid, **kw)
         elif self.info.fmi_version == 3:
             cls = fmi3.FMU3Slave if slave else fmi3.FMU3Model
-            self.fmu = cls(instantiationToken=self.info.guid, **kw)
+            self.fmu = cls(guid=self.info.guid, **kw)   # fmpy: the token is passed as guid
         else:
             raise SetupError(f"element {self.name!r}: FMI {self.info.fmi_version} is not "
                              "supported (FMI 2.0 and 3.0 are)")

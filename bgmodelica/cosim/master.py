@@ -11,9 +11,10 @@ Macro step ``H`` (communication points ``t_k = t0 + k H``), two orders:
 Inputs over a step are ``u(t) = u0 + slope (t - t_k)``:
 
 * no extrapolation: ``slope = 0``, ``u0`` = the newest coupling value (zero-order hold);
-* ``extrapolation=True``: linear. From a unit not yet stepped (always in Jacobi) the line
-  through the values at ``t_{k-1}`` and ``t_k`` (*extrapolation*); from a unit already stepped
-  in Gauss-Seidel the line through its values at ``t_k`` and ``t_{k+1}`` (*interpolation*).
+* ``extrapolation=True``: linear. For a value already known at ``t_{k+1}`` (Gauss-Seidel: its
+  unit has stepped and the output does not depend directly on an input still at ``t_k``) the
+  line through its values at ``t_k`` and ``t_{k+1}`` (*interpolation*); otherwise (always in
+  Jacobi) the line through the values at ``t_{k-1}`` and ``t_k`` (*extrapolation*).
   Model Exchange units follow the ramp; Co-Simulation units hold its mean over the step
   (``u0 + slope H/2``, the same integral: second order for integrated quantities).
 
@@ -112,7 +113,7 @@ class Master:
                  start_time: float | None = None, sequence: Sequence[str] | None = None,
                  parameters: Mapping[str, Mapping[str, float]] | None = None,
                  record: Iterable[str] = (), tolerance: float | None = None,
-                 record_every: int = 1) -> Result:
+                 record_every: int = 1, max_abs: float | None = None) -> Result:
         """Run the co-simulation and return the :class:`~bgmodelica.Result`.
 
         ``stop_time``/``step``: default from the SSD (DefaultExperiment, the master
@@ -120,6 +121,8 @@ class Master:
         on top of the SSD bindings. ``record``: extra variables ``element.variable``.
         ``tolerance``: passed to the FMUs' ``setupExperiment`` (None: not defined).
         ``record_every``: keep every n-th communication point (the last one always).
+        ``max_abs``: stop with :class:`~.errors.CosimStepError` as soon as a coupled output
+        exceeds this magnitude (an unstable coupling; None: only non-finite values stop).
         """
         system = self.system
         order = _norm_order(order)
@@ -253,14 +256,14 @@ class Master:
                     y = {n: units[n].get_outputs() for n in names}
                 else:
                     y_old = dict(y)
-                    stepped: set[str] = set()
+                    fresh = {m: np.zeros(len(plan.outputs[m]), dtype=bool) for m in names}
                     for n in seq:
                         u0 = u_now[n].copy()
                         slope = np.zeros_like(u0) if extrapolation else None
                         for j, s in enumerate(src_index[n]):
                             if s is None:
                                 continue
-                            if s[0] in stepped:
+                            if fresh[s[0]][s[1]]:       # a t_k+1 value: interpolate
                                 new, old = y[s[0]][s[1]], y_old[s[0]][s[1]]
                                 if extrapolation:
                                     u0[j], slope[j] = old, (new - old) / h
@@ -268,6 +271,8 @@ class Master:
                                     u0[j] = new
                             elif extrapolation and u_prev is not None:
                                 slope[j] = (u_now[n][j] - u_prev[n][j]) / h
+                            elif not extrapolation:
+                                u0[j] = y[s[0]][s[1]]   # the newest value there is
                         units[n].step(t, h, u0, slope)
                         last_set[n] = u0 if slope is None else None
                         y[n] = units[n].get_outputs()
@@ -276,7 +281,12 @@ class Master:
                             units[n].set_inputs(u)
                             last_set[n] = u
                             y[n] = units[n].get_outputs()
-                        stepped.add(n)
+                        # an output is at t_k+1 if every input it depends on directly is
+                        fresh_in = {plan.inputs[n][j]: s is None or bool(fresh[s[0]][s[1]])
+                                    for j, s in enumerate(src_index[n])}
+                        fresh[n] = np.array([all(fresh_in.get(u, True)
+                                                 for u in plan.feedthrough[n].get(yn, []))
+                                             for yn in plan.outputs[n]], dtype=bool)
                 for n in names:
                     if last_set[n] is None:
                         last_set[n] = np.full(len(u_now[n]), np.nan)
@@ -284,11 +294,15 @@ class Master:
                     propagate_outputs()
                 u_prev = u_now
                 for n in names:
-                    if not np.all(np.isfinite(y[n])):
-                        bad = [plan.outputs[n][i] for i in np.flatnonzero(~np.isfinite(y[n]))]
+                    bad_mask = ~np.isfinite(y[n])
+                    if max_abs is not None:
+                        bad_mask |= np.abs(y[n]) > max_abs
+                    if bad_mask.any():
+                        bad = [f"{plan.outputs[n][i]} = {y[n][i]:g}"
+                               for i in np.flatnonzero(bad_mask)]
                         raise CosimStepError(
-                            f"element {n!r}: output(s) {', '.join(bad)} not finite at "
-                            f"t={t + h:g} (the coupling may be unstable at macro step {h:g} s)",
+                            f"element {n!r}: output(s) {', '.join(bad)} at t={t + h:g}: the "
+                            f"co-simulation diverges (unstable coupling at macro step {h:g} s?)",
                             n, t + h)
                 record_point(k + 1, t0 + (k + 1) * h)
             wall_run = _time.perf_counter() - wall1

@@ -25,6 +25,7 @@ of FMU components are supported.
 
 from __future__ import annotations
 
+import atexit
 import math
 import shutil
 import tempfile
@@ -251,10 +252,16 @@ def ssd_xml(system: SystemStructure) -> bytes:
         anns = ET.SubElement(exp, _q("ssd", "Annotations"))
         ann = ET.SubElement(anns, _q("ssc", "Annotation"), type=ANNOTATION_TYPE)
         ET.SubElement(ann, f"{{{BGM_NS}}}Master",
-                      {_camel(k): str(v) for k, v in system.master.items()})
+                      {_camel(k): _text(v) for k, v in system.master.items()})
     ET.indent(root, space="  ")
     text = ET.tostring(root, encoding="unicode")
     return ('<?xml version="1.0" encoding="UTF-8"?>\n' + text + "\n").encode("utf-8")
+
+
+def _text(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return repr(value) if isinstance(value, float) else str(value)
 
 
 def _camel(key: str) -> str:
@@ -461,7 +468,8 @@ def _auto(text: str) -> Any:
 
 def read_ssp(path: str | Path, extract_to: str | Path | None = None) -> SystemStructure:
     """Read an ``.ssp`` archive; its FMUs are extracted to ``extract_to`` (default: a new
-    temporary directory, ``system.root``) and each component's ``fmu_path`` points there."""
+    temporary directory, removed at exit; ``system.root``) and each component's ``fmu_path``
+    points there."""
     path = Path(path)
     if not path.is_file():
         raise SspFormatError(f"SSP file {path} does not exist")
@@ -475,7 +483,11 @@ def read_ssp(path: str | Path, extract_to: str | Path | None = None) -> SystemSt
         except KeyError:
             raise SspFormatError(f"{path}: no {SSD_NAME} in the archive") from None
         system = parse_ssd(text, zf)
-        root = Path(extract_to) if extract_to else Path(tempfile.mkdtemp(prefix="bgm_ssp_"))
+        if extract_to:
+            root = Path(extract_to)
+        else:
+            root = Path(tempfile.mkdtemp(prefix="bgm_ssp_"))
+            atexit.register(shutil.rmtree, root, True)
         root.mkdir(parents=True, exist_ok=True)
         members = set(zf.namelist())
         for comp in system.elements:

@@ -12,7 +12,10 @@ subsystem *receives* and which it *returns*:
   derivative (``order=1``, a speed source; the potential is integrated from ``start``). Pair it
   with :class:`FlowOutput` to return the flow the component exerts on its environment.
 * a plain string -- an existing variable: for inputs an ``Input`` of a subcomponent (joined to
-  the new top-level input), for outputs any variable (``name == path``).
+  the new top-level input), for outputs any variable (``name == path``). A top-level
+  variable mapped to its own name is turned into an ``Output`` in place. (If the compiler then
+  picks that very variable as a *state*, the FMU exporter keeps it a state, not an output:
+  expose a state under a new name, e.g. ``outputs={"x": "y"}`` for an integrator's ``y``.)
 
 Causality must make sense physically: a component holding an inertia rigidly at a connector
 can only be driven by a *flow* there (a prescribed speed would need its derivative: the

@@ -1,0 +1,148 @@
+"""Command-line subcommands of the co-simulation package (wired into ``bgmodelica`` through
+``bgmodelica.cli._EXTENSIONS`` with :func:`register`):
+
+``bgmodelica cosim SSP [--step H] [--order jacobi|gauss-seidel] [--stop-time T] [-o out.csv]``
+    co-simulate an SSP set-up with the fixed-step master (``--extrapolation``,
+    ``--interface cs|me|auto``, ``--no-propagate``, ``--set ELEMENT.NAME=VALUE``,
+    ``--record ELEMENT.VAR``, ``--plot out.png``).
+``bgmodelica verify [--steps 10e-3,5e-3,2e-3,1e-3,5e-4] [--json] [--plot out.png]``
+    the paper's PID robot, monolithic vs co-simulated: error table per joint, observed
+    convergence order, both orders with and without extrapolation, wall time per simulated
+    second, cross-check with fmucontainer (``--stop-time``, ``--coupling lumped|plain``,
+    ``--no-me``, ``--no-cross-check``, ``--fmu-dir DIR`` to keep the FMUs).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from ..errors import ParameterError
+
+
+def _sets(items: list[str]) -> dict[str, dict[str, float]]:
+    out: dict[str, dict[str, float]] = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        el, dot, var = name.strip().partition(".")
+        if not sep or not dot or not var:
+            raise ParameterError(f"--set expects ELEMENT.NAME=VALUE, got {item!r}")
+        try:
+            out.setdefault(el, {})[var] = float(value)
+        except ValueError:
+            raise ParameterError(f"--set {name}: {value!r} is not a number") from None
+    return out
+
+
+def cmd_cosim(args: argparse.Namespace) -> int:
+    """``bgmodelica cosim``: run an SSP set-up, write the CSV (and a plot)."""
+    from .master import Master
+    from .ssp import read_ssp
+
+    system = read_ssp(args.ssp)
+    master = Master(system, interface=args.interface)
+    order = args.order or system.master.get("order", "jacobi")
+    extrapolation = args.extrapolation
+    if extrapolation is None:
+        extrapolation = bool(system.master.get("extrapolation", False))
+    res = master.simulate(args.stop_time, args.step, order=order, extrapolation=extrapolation,
+                          propagate=not args.no_propagate, parameters=_sets(args.set),
+                          record=args.record or ())
+    out = Path(args.output) if args.output else Path(f"{system.name}_cosim.csv")
+    res.to_csv(out)
+    meta = res.meta
+    print(f"{system.name}: {len(system.elements)} elements ({', '.join(system.element_names)}),"
+          f" {meta['order']}{' + extrapolation' if meta['extrapolation'] else ''}, "
+          f"step {meta['step']:g} s, {meta['steps']} steps to t = {meta['stop_time']:g} s; "
+          f"run {meta['run_seconds']:.3f} s ({meta['seconds_per_simulated_second']:.3f} s "
+          f"per simulated s) -> {out}")
+    if args.plot:
+        names = args.plot_vars or [n for n in res.names
+                                   if n.split(".", 1)[0] == system.element_names[0]][:6]
+        res.plot(names, args.plot, title=f"{system.name} (co-simulation)")
+        print(f"plot -> {args.plot}")
+    return 0
+
+
+def _steps(text: str) -> list[float]:
+    try:
+        steps = [float(s) for s in text.split(",") if s.strip()]
+    except ValueError:
+        raise ParameterError(f"--steps expects comma-separated numbers, got {text!r}") from None
+    if not steps or any(s <= 0 for s in steps):
+        raise ParameterError(f"--steps: positive macro steps required, got {text!r}")
+    return steps
+
+
+def cmd_verify(args: argparse.Namespace) -> int:
+    """``bgmodelica verify``: monolithic robot vs co-simulation."""
+    from .verify import verify_robot
+
+    def progress(msg: str) -> None:
+        if not args.quiet:
+            sys.stderr.write(f"  {msg}\n")
+            sys.stderr.flush()
+
+    work = Path(args.fmu_dir) if args.fmu_dir else None
+    report = verify_robot(_steps(args.steps), args.stop_time, coupling=args.coupling,
+                          me_step=None if args.no_me else 1e-3,
+                          cross_check_step=None if args.no_cross_check else 1e-3,
+                          work_dir=work, progress=progress)
+    if args.json:
+        print(json.dumps(report.to_dict(), indent=2))
+    else:
+        print(report.to_text())
+    if args.plot:
+        path = report.plot(args.plot)
+        if not args.json:
+            print(f"plot -> {path}")
+    return 0
+
+
+def register(sub: Any, model_args: Any = None) -> None:
+    """Add the ``cosim`` and ``verify`` subcommands to the ``bgmodelica`` parser (``sub``:
+    its subparsers; ``model_args`` is unused: these commands take SSP files, not models)."""
+    del model_args
+    cos = sub.add_parser("cosim", help="co-simulate an SSP set-up of FMUs (fixed-step master)")
+    cos.add_argument("ssp", help="the .ssp file (SystemStructure.ssd + FMUs in resources/)")
+    cos.add_argument("--step", type=float, default=None,
+                     help="macro step [s] (default: the SSP's, else 1e-3)")
+    cos.add_argument("--order", choices=["jacobi", "gauss-seidel"], default=None,
+                     help="coupling order (default: the SSP's, else jacobi)")
+    cos.add_argument("--stop-time", type=float, default=None,
+                     help="[s] (default: the SSP DefaultExperiment)")
+    cos.add_argument("--extrapolation", action=argparse.BooleanOptionalAction, default=None,
+                     help="linear extrapolation (interpolation in Gauss-Seidel) of the inputs")
+    cos.add_argument("--interface", choices=["cs", "me", "auto"], default="cs",
+                     help="Co-Simulation FMUs (own solvers) or Model Exchange (master's "
+                          "integrator)")
+    cos.add_argument("--no-propagate", action="store_true",
+                     help="read outputs right after doStep (no feedthrough evaluation at "
+                          "communication points)")
+    cos.add_argument("--set", action="append", default=[], metavar="ELEMENT.NAME=VALUE",
+                     help="override a parameter of an element")
+    cos.add_argument("--record", nargs="+", metavar="ELEMENT.VAR",
+                     help="record more variables (locals, states)")
+    cos.add_argument("-o", "--output", help="CSV file (default <system>_cosim.csv)")
+    cos.add_argument("--plot", help="PNG with the first element's connectors (or --plot-vars)")
+    cos.add_argument("--plot-vars", nargs="+", help="variables to plot")
+    cos.set_defaults(func=cmd_cosim)
+
+    ver = sub.add_parser("verify", help="PID robot: monolithic vs co-simulation (errors, "
+                                        "convergence order, timing, fmucontainer check)")
+    ver.add_argument("--steps", default="10e-3,5e-3,2e-3,1e-3,5e-4",
+                     help="comma-separated macro steps [s]")
+    ver.add_argument("--stop-time", type=float, default=10.0, help="[s] (default 10)")
+    ver.add_argument("--coupling", choices=["lumped", "plain"], default="lumped",
+                     help="subsystem split (see library.robots.subsystems)")
+    ver.add_argument("--json", action="store_true", help="machine-readable report")
+    ver.add_argument("--plot", help="PNG: error vs macro step per joint")
+    ver.add_argument("--no-me", action="store_true", help="skip the Model Exchange runs")
+    ver.add_argument("--no-cross-check", action="store_true",
+                     help="skip the fmucontainer cross-check")
+    ver.add_argument("--fmu-dir", help="build (and keep) the FMUs here")
+    ver.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    ver.set_defaults(func=cmd_verify)
