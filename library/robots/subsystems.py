@@ -71,10 +71,10 @@ from bgmodelica import (
 from bgmodelica.core.expressions import fmax, fmin
 from bgmodelica.cosim.wrap import FlowInput, FlowOutput, PotentialInput, expose
 from library.blocks import LimPID
-from library.electrical import EMF, Ground, Inductor, Resistor, SignalVoltage
-from library.rotational import Damper, Fixed, Flange, IdealGear, Inertia
+from library.rotational import Damper, Fixed, Inertia
 
 from .arm import ARM_PARAMETERS, TwoLinkArm
+from .motor import GearedMotor
 from .params import MOTOR, PID, REFERENCE, VMAX
 from .robot import SineReference
 
@@ -102,52 +102,6 @@ def drive_damping(R: float = MOTOR["R"], k1: float = MOTOR["k1"], b: float = MOT
 def _check_coupling(coupling: str) -> None:
     if coupling not in COUPLINGS:
         raise ValueError(f"coupling must be one of {COUPLINGS}, not {coupling!r}")
-
-
-class GearedMotor(Component):
-    """The paper's geared DC motor *without* rotor inertia (it is lumped into the joint).
-
-    Connectors: ``u`` (Input, armature voltage [V]), ``flange`` (joint side of the gear).
-    Outputs: ``i`` armature current [A], ``w_m`` rotor speed [rad/s]. Parameters: R [Ohm],
-    L [H], k1 [N.m/A], b [N.m.s/rad] rotor friction, k2 [1] gear ratio (defaults
-    :data:`library.robots.params.MOTOR`). Sub-component names follow
-    :class:`~library.robots.motor.DCMotor` (source, resistor, inductor, emf, friction, gear).
-    """
-
-    R = Parameter(MOTOR["R"], unit="Ohm", description="Armature resistance")
-    L = Parameter(MOTOR["L"], unit="H", description="Armature inductance")
-    k1 = Parameter(MOTOR["k1"], unit="N.m/A", description="Torque / back-EMF constant")
-    b = Parameter(MOTOR["b"], unit="N.m.s/rad", description="Rotor viscous friction")
-    k2 = Parameter(MOTOR["k2"], unit="1", description="Gear ratio w_motor / w_joint")
-    u = Input(unit="V", description="Armature voltage command")
-    i = Output(unit="A", description="Armature current")
-    w_m = Output(unit="rad/s", description="Rotor speed")
-    flange = Flange()
-
-    def __init__(self, name: str | None = None, **modifiers: Any):
-        super().__init__(name, **modifiers)
-        self.source = SignalVoltage()
-        self.resistor = Resistor(R=self.R)
-        self.inductor = Inductor(L=self.L, i=0.0)
-        self.emf = EMF(k=self.k1)
-        self.ground = Ground()
-        self.friction = Damper(d=self.b)
-        self.housing = Fixed()
-        self.gear = IdealGear(ratio=self.k2)
-
-    def equations(self):
-        yield connect(self.u, self.source.u)
-        yield connect(self.source.p, self.resistor.p)
-        yield connect(self.resistor.n, self.inductor.p)
-        yield connect(self.inductor.n, self.emf.p)
-        yield connect(self.emf.n, self.source.n)
-        yield connect(self.source.n, self.ground.p)
-        yield connect(self.emf.flange, self.gear.flange_a)
-        yield connect(self.friction.flange_a, self.housing.flange)
-        yield connect(self.friction.flange_b, self.emf.flange)
-        yield connect(self.gear.flange_b, self.flange)
-        yield self.i == self.inductor.i
-        yield self.w_m == self.emf.w
 
 
 class DrivenArm(TwoLinkArm):
