@@ -38,11 +38,12 @@ class ModelFunctions:
     ode: ca.Function
     fwd: ca.Function
     jacx: ca.Function
+    xdot: ca.Function
     init: ca.Function | None
     initfwd: ca.Function | None
 
     def all(self) -> list[ca.Function]:
-        return [f for f in (self.ode, self.fwd, self.jacx, self.init, self.initfwd)
+        return [f for f in (self.ode, self.fwd, self.jacx, self.xdot, self.init, self.initfwd)
                 if f is not None]
 
 
@@ -94,8 +95,10 @@ def build_functions(spec: FmuSpec, prefix: str) -> ModelFunctions:
     sens = ca.densify(ca.jtimes(both, ca.vertcat(x, u, p), seed))
     fwd = ca.Function(f"{prefix}fwd", [t, x, u, p, dx, du, dp], [sens[:nx], sens[nx:]],
                       ["t", "x", "u", "p", "dx", "du", "dp"], ["dxdot", "dy"])
-    jacx = ca.Function(f"{prefix}jacx", [t, x, u, p], [ca.densify(ca.jacobian(xdot, x))],
-                       ["t", "x", "u", "p"], ["J"])
+    jacx = _pruned(ca.Function(f"{prefix}jacx", [t, x, u, p],
+                               [ca.densify(ca.jacobian(xdot, x))], ["t", "x", "u", "p"], ["J"]))
+    xdot_only = _pruned(ca.Function(f"{prefix}xdot", [t, x, u, p], [xdot],
+                                    ["t", "x", "u", "p"], ["xdot"]))
     init = initfwd = None
     if spec.init is not None:
         (x0,) = _call(spec.init, [t, u, p])
@@ -106,7 +109,17 @@ def build_functions(spec: FmuSpec, prefix: str) -> ModelFunctions:
         initfwd = ca.Function(f"{prefix}initfwd", [t, u, p, du, dp],
                               [sens0[:nx], sens0[nx:2 * nx], sens0[2 * nx:]],
                               ["t", "u", "p", "du", "dp"], ["dx0", "dxdot0", "dy0"])
-    return ModelFunctions(ode, fwd, jacx, init, initfwd)
+    return ModelFunctions(ode, fwd, jacx, xdot_only, init, initfwd)
+
+
+def _pruned(f: ca.Function) -> ca.Function:
+    """``f`` expanded to SX where possible: the generated code then evaluates only what its
+    outputs need (the solver's xdot and Jacobian skip the outputs ``y``). Functions holding
+    a rootfinder cannot be expanded and stay as they are."""
+    try:
+        return f.expand()
+    except RuntimeError:
+        return f
 
 
 def generate_c(funcs: ModelFunctions, out_dir: Path, basename: str, prefix: str) -> list[str]:

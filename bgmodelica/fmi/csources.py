@@ -107,6 +107,7 @@ def model_data_sources(spec: FmuSpec, table: VariableTable, version: int, token:
         f"#define BGM_CASADI_ODE {prefix}ode",
         f"#define BGM_CASADI_FWD {prefix}fwd",
         f"#define BGM_CASADI_JACX {prefix}jacx",
+        f"#define BGM_CASADI_XDOT {prefix}xdot",
     ]
     if has_init:
         lines += [f"#define BGM_CASADI_INIT {prefix}init",

@@ -35,10 +35,11 @@ typedef struct {
             BGM_CAT(F, _incref), BGM_CAT(F, _decref)                               \
     }
 
-enum { F_ODE = 0, F_FWD, F_JACX, F_INIT, F_INITFWD };
+enum { F_ODE = 0, F_FWD, F_JACX, F_XDOT, F_INIT, F_INITFWD };
 
 static const bgm_function bgm_functions[] = {
     BGM_FUNCTION(BGM_CASADI_ODE), BGM_FUNCTION(BGM_CASADI_FWD), BGM_FUNCTION(BGM_CASADI_JACX),
+    BGM_FUNCTION(BGM_CASADI_XDOT),
 #if BGM_HAS_INIT
     BGM_FUNCTION(BGM_CASADI_INIT), BGM_FUNCTION(BGM_CASADI_INITFWD),
 #endif
@@ -73,6 +74,20 @@ int bgm_call_ode(bgm_inst *c, double t, const double *x, double *xdot, double *y
     if (bgm_call(c, F_ODE, args, 4, outs, 2)) return 1;
     if (xdot && !bgm_all_finite(xdot, BGM_NX)) return 2;
     if (y && !bgm_all_finite(y, BGM_NY)) return 2;
+    return 0;
+}
+
+int bgm_call_xdot(bgm_inst *c, double t, const double *x, double *xdot) {
+    const double *args[4];
+    double *outs[1];
+    args[0] = &t;
+    args[1] = x;
+    args[2] = c->v.u;
+    args[3] = c->v.p;
+    outs[0] = xdot;
+    c->stat_f++;
+    if (bgm_call(c, F_XDOT, args, 4, outs, 1)) return 1;
+    if (!bgm_all_finite(xdot, BGM_NX)) return 2;
     return 0;
 }
 
@@ -333,10 +348,34 @@ bgm_status bgm_update_x0(bgm_inst *c, const char *fn) {
     return BGM_OK;
 }
 
+/* cache_valid: 0 nothing, 1 derivatives, 2 derivatives and outputs (see bgm_eval_y) */
 bgm_status bgm_eval(bgm_inst *c, const char *fn) {
     int rc;
     size_t i;
     if (c->cache_valid) return BGM_OK;
+    if (bgm_update_x0(c, fn) != BGM_OK) return BGM_ERROR;
+    rc = BGM_NX ? bgm_call_xdot(c, c->v.time, c->v.x, c->xdot) : 0;
+    if (rc == 1) {
+        bgm_error(c, "%s: model evaluation failed at t=%g", fn, c->v.time);
+        return BGM_ERROR;
+    }
+    if (rc == 2) {
+        for (i = 0; i < BGM_NX; i++)
+            if (!isfinite(c->xdot[i])) {
+                bgm_error(c, "%s: model evaluation returned %g for %s at t=%g", fn, c->xdot[i],
+                          bgm_var_names[BGM_VR_DX + i], c->v.time);
+                return BGM_ERROR;
+            }
+        return BGM_ERROR;
+    }
+    c->cache_valid = 1;
+    return BGM_OK;
+}
+
+bgm_status bgm_eval_y(bgm_inst *c, const char *fn) {
+    int rc;
+    size_t i;
+    if (c->cache_valid == 2) return BGM_OK;
     if (bgm_update_x0(c, fn) != BGM_OK) return BGM_ERROR;
     rc = bgm_call_ode(c, c->v.time, c->v.x, c->xdot, c->y);
     if (rc == 1) {
@@ -358,7 +397,7 @@ bgm_status bgm_eval(bgm_inst *c, const char *fn) {
             }
         return BGM_ERROR;
     }
-    c->cache_valid = 1;
+    c->cache_valid = 2;
     return BGM_OK;
 }
 
@@ -440,7 +479,7 @@ bgm_status bgm_get_real(bgm_inst *c, const char *fn, const unsigned vr[], size_t
         case BGM_VAR_INPUT: values[k] = c->v.u[i]; break;
         case BGM_VAR_PARAMETER: values[k] = c->v.p[i]; break;
         case BGM_VAR_OUTPUT:
-            if (bgm_eval(c, fn) != BGM_OK) return BGM_ERROR;
+            if (bgm_eval_y(c, fn) != BGM_OK) return BGM_ERROR;
             values[k] = c->y[i];
             break;
         case BGM_VAR_SOLVER: values[k] = i == 0 ? c->v.solver_tol : c->v.solver_hmax; break;

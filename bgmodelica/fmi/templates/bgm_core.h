@@ -156,6 +156,7 @@ bgm_status bgm_set_real(bgm_inst *c, const char *fn, const unsigned vr[], size_t
 bgm_status bgm_no_variables(bgm_inst *c, const char *fn, const char *type,
                             const unsigned vr[], size_t n);
 bgm_status bgm_eval(bgm_inst *c, const char *fn);
+bgm_status bgm_eval_y(bgm_inst *c, const char *fn);
 bgm_status bgm_update_x0(bgm_inst *c, const char *fn);
 bgm_status bgm_directional_derivative(bgm_inst *c, const char *fn, const unsigned unknowns[],
                                       size_t nu, const unsigned knowns[], size_t nk,
@@ -186,6 +187,7 @@ bgm_status bgm_deserialize(bgm_inst *c, const char *fn, const void *bytes, size_
 
 /* raw model calls (0 on success); used by the solver */
 int bgm_call_ode(bgm_inst *c, double t, const double *x, double *xdot, double *y);
+int bgm_call_xdot(bgm_inst *c, double t, const double *x, double *xdot);
 int bgm_call_jacx(bgm_inst *c, double t, const double *x, double *jac);
 
 #endif

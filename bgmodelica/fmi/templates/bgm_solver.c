@@ -119,7 +119,7 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
     if (!(h > 0.0)) {
         /* initial step guess from the size of x and xdot */
         double d0, d1;
-        if (bgm_call_ode(c, t, x0, f0, NULL)) goto eval_failed;
+        if (bgm_call_xdot(c, t, x0, f0)) goto eval_failed;
         have_f0 = 1;
         for (i = 0; i < n; i++) sc[i] = rtol * bgm_x_nominal[i] + rtol * fabs(x0[i]);
         d0 = wnorm(x0, sc, n);
@@ -149,7 +149,7 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
             return BGM_ERROR;
         }
         if (!have_f0) {
-            if (bgm_call_ode(c, t, x0, f0, NULL)) goto eval_failed;
+            if (bgm_call_xdot(c, t, x0, f0)) goto eval_failed;
             have_f0 = 1;
         }
         rc = bgm_call_jacx(c, t, x0, J);
@@ -182,7 +182,7 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
             }
             for (it = 0; it < MAX_NEWTON; it++) {
                 double nrm;
-                rc = bgm_call_ode(c, ts, Y, F, NULL);
+                rc = bgm_call_xdot(c, ts, Y, F);
                 if (rc == 1) goto eval_failed;
                 if (rc == 2) {
                     why = "non-finite model evaluation during Newton iteration";
