@@ -50,7 +50,7 @@ class DCMotor(Component):
         yield connect(self.damper.flange_b, self.fixed.flange)
 
 
-class PIDSpeedControl(Component):
+class PIDSpeedControl(DCMotor):
     """Speed loop of the :class:`DCMotor` drive: LimPID -> signal voltage source.
 
     setpoint: Step 0 -> 100 rad/s at t = 0.1 s. load_torque: Step 0 -> 0.5 N.m (braking) at
@@ -64,31 +64,14 @@ class PIDSpeedControl(Component):
     setpoint = Step(height=100.0, start_time=0.1)
     load_torque = Step(height=-0.5, start_time=1.0)
     controller = LimPID(controller_type="PI", k=4.0, Ti=0.2, Ni=0.9, y_max=24.0, y_min=-24.0)
-    source = SignalVoltage()
-    resistor = Resistor(R=1.0)
-    inductor = Inductor(L=0.01, i=0.0)
-    emf = EMF(k=0.1)
-    ground = Ground()
-    rotor = Inertia(J=0.002, phi=0.0, w=0.0)
-    load = Inertia(J=0.008)
-    damper = Damper(d=0.001)
-    fixed = Fixed()
+    source = SignalVoltage()            # redeclares the DCMotor's constant source
     torque = Torque()
     speed_sensor = SpeedSensor()
 
-    def equations(self):
+    def equations(self):                # the drive's connections are inherited
         yield connect(self.setpoint.y, self.controller.u_s)
         yield connect(self.speed_sensor.w, self.controller.u_m)
         yield connect(self.controller.y, self.source.u)
         yield connect(self.load_torque.y, self.torque.tau)
-        yield connect(self.source.p, self.resistor.p)
-        yield connect(self.resistor.n, self.inductor.p)
-        yield connect(self.inductor.n, self.emf.p)
-        yield connect(self.emf.n, self.source.n)
-        yield connect(self.source.n, self.ground.p)
-        yield connect(self.emf.flange, self.rotor.flange_a)
-        yield connect(self.rotor.flange_b, self.load.flange_a)
-        yield connect(self.load.flange_b, self.damper.flange_a)
-        yield connect(self.damper.flange_b, self.fixed.flange)
         yield connect(self.torque.flange, self.load.flange_b)
         yield connect(self.speed_sensor.flange, self.rotor.flange_b)

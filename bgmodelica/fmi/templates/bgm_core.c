@@ -61,48 +61,40 @@ static int bgm_all_finite(const double *v, size_t n) {
     return 1;
 }
 
-int bgm_call_ode(bgm_inst *c, double t, const double *x, double *xdot, double *y) {
+/* Call model function f at (t, x, u, p); 0 ok, 1 evaluation failed, 2 non-finite output. */
+static int bgm_call_model(bgm_inst *c, int f, double t, const double *x, double **outs,
+                          const size_t *sizes, int nouts) {
     const double *args[4];
-    double *outs[2];
+    int i;
     args[0] = &t;
     args[1] = x;
     args[2] = c->v.u;
     args[3] = c->v.p;
-    outs[0] = xdot;
-    outs[1] = y;
-    c->stat_f++;
-    if (bgm_call(c, F_ODE, args, 4, outs, 2)) return 1;
-    if (xdot && !bgm_all_finite(xdot, BGM_NX)) return 2;
-    if (y && !bgm_all_finite(y, BGM_NY)) return 2;
+    if (bgm_call(c, f, args, 4, outs, nouts)) return 1;
+    for (i = 0; i < nouts; i++)
+        if (outs[i] && !bgm_all_finite(outs[i], sizes[i])) return 2;
     return 0;
+}
+
+int bgm_call_ode(bgm_inst *c, double t, const double *x, double *xdot, double *y) {
+    double *outs[2] = {xdot, y};
+    const size_t sizes[2] = {BGM_NX, BGM_NY};
+    c->stat_f++;
+    return bgm_call_model(c, F_ODE, t, x, outs, sizes, 2);
 }
 
 int bgm_call_xdot(bgm_inst *c, double t, const double *x, double *xdot) {
-    const double *args[4];
-    double *outs[1];
-    args[0] = &t;
-    args[1] = x;
-    args[2] = c->v.u;
-    args[3] = c->v.p;
-    outs[0] = xdot;
+    double *outs[1] = {xdot};
+    const size_t sizes[1] = {BGM_NX};
     c->stat_f++;
-    if (bgm_call(c, F_XDOT, args, 4, outs, 1)) return 1;
-    if (!bgm_all_finite(xdot, BGM_NX)) return 2;
-    return 0;
+    return bgm_call_model(c, F_XDOT, t, x, outs, sizes, 1);
 }
 
 int bgm_call_jacx(bgm_inst *c, double t, const double *x, double *jac) {
-    const double *args[4];
-    double *outs[1];
-    args[0] = &t;
-    args[1] = x;
-    args[2] = c->v.u;
-    args[3] = c->v.p;
-    outs[0] = jac;
+    double *outs[1] = {jac};
+    const size_t sizes[1] = {(size_t)BGM_NX * BGM_NX};
     c->stat_jac++;
-    if (bgm_call(c, F_JACX, args, 4, outs, 1)) return 1;
-    if (!bgm_all_finite(jac, (size_t)BGM_NX * BGM_NX)) return 2;
-    return 0;
+    return bgm_call_model(c, F_JACX, t, x, outs, sizes, 1);
 }
 
 /* ------------------------------------------------------------------------- logging */
@@ -348,13 +340,17 @@ bgm_status bgm_update_x0(bgm_inst *c, const char *fn) {
     return BGM_OK;
 }
 
-/* cache_valid: 0 nothing, 1 derivatives, 2 derivatives and outputs (see bgm_eval_y) */
-bgm_status bgm_eval(bgm_inst *c, const char *fn) {
+/* cache_valid: 0 nothing, 1 derivatives, 2 derivatives and outputs. The solver and
+   GetDerivatives need only xdot (level 1); outputs are computed when read (level 2). */
+static bgm_status bgm_evaluate(bgm_inst *c, const char *fn, int level) {
     int rc;
     size_t i;
-    if (c->cache_valid) return BGM_OK;
+    if (c->cache_valid >= level) return BGM_OK;
     if (bgm_update_x0(c, fn) != BGM_OK) return BGM_ERROR;
-    rc = BGM_NX ? bgm_call_xdot(c, c->v.time, c->v.x, c->xdot) : 0;
+    if (level == 2)
+        rc = bgm_call_ode(c, c->v.time, c->v.x, c->xdot, c->y);
+    else
+        rc = BGM_NX ? bgm_call_xdot(c, c->v.time, c->v.x, c->xdot) : 0;
     if (rc == 1) {
         bgm_error(c, "%s: model evaluation failed at t=%g", fn, c->v.time);
         return BGM_ERROR;
@@ -366,30 +362,7 @@ bgm_status bgm_eval(bgm_inst *c, const char *fn) {
                           bgm_var_names[BGM_VR_DX + i], c->v.time);
                 return BGM_ERROR;
             }
-        return BGM_ERROR;
-    }
-    c->cache_valid = 1;
-    return BGM_OK;
-}
-
-bgm_status bgm_eval_y(bgm_inst *c, const char *fn) {
-    int rc;
-    size_t i;
-    if (c->cache_valid == 2) return BGM_OK;
-    if (bgm_update_x0(c, fn) != BGM_OK) return BGM_ERROR;
-    rc = bgm_call_ode(c, c->v.time, c->v.x, c->xdot, c->y);
-    if (rc == 1) {
-        bgm_error(c, "%s: model evaluation failed at t=%g", fn, c->v.time);
-        return BGM_ERROR;
-    }
-    if (rc == 2) {
-        for (i = 0; i < BGM_NX; i++)
-            if (!isfinite(c->xdot[i])) {
-                bgm_error(c, "%s: model evaluation returned %g for %s at t=%g", fn, c->xdot[i],
-                          bgm_var_names[BGM_VR_DX + i], c->v.time);
-                return BGM_ERROR;
-            }
-        for (i = 0; i < BGM_NY; i++)
+        for (i = 0; level == 2 && i < BGM_NY; i++)
             if (!isfinite(c->y[i])) {
                 bgm_error(c, "%s: model evaluation returned %g for %s at t=%g", fn, c->y[i],
                           bgm_var_names[BGM_VR_Y + i], c->v.time);
@@ -397,9 +370,13 @@ bgm_status bgm_eval_y(bgm_inst *c, const char *fn) {
             }
         return BGM_ERROR;
     }
-    c->cache_valid = 2;
+    c->cache_valid = level;
     return BGM_OK;
 }
+
+bgm_status bgm_eval(bgm_inst *c, const char *fn) { return bgm_evaluate(c, fn, 1); }
+
+bgm_status bgm_eval_y(bgm_inst *c, const char *fn) { return bgm_evaluate(c, fn, 2); }
 
 bgm_status bgm_exit_init(bgm_inst *c, const char *fn) {
     if (!bgm_check(c, fn, BGM_MODE_INIT)) return BGM_ERROR;
