@@ -22,9 +22,30 @@ from .core.expressions import (
     tanh,
 )
 from .core.flatten import flatten
+from .core.hybrid import (
+    and_,
+    change,
+    edge,
+    eq,
+    if_equation,
+    initial,
+    no_event,
+    noEvent,
+    not_,
+    or_,
+    pre,
+    reinit,
+    sample,
+    terminal,
+    time_table,
+    when,
+)
 from .core.variables import (
+    Boolean,
+    Discrete,
     Flow,
     Input,
+    Integer,
     Output,
     Parameter,
     Potential,
@@ -39,6 +60,9 @@ __all__ = [
     "Component", "Connection", "Connector", "connect", "der", "time", "flatten",
     "Parameter", "Variable", "Potential", "Flow", "Input", "Output", "StateSelect",
     "sin", "cos", "tan", "exp", "log", "sqrt", "atan2", "fabs", "tanh", "sign", "if_else",
+    "Discrete", "Integer", "Boolean", "when", "reinit", "pre", "edge", "change", "initial",
+    "terminal", "sample", "no_event", "noEvent", "eq", "and_", "or_", "not_", "if_equation",
+    "time_table",
 ]
 
 from .compiler import CompiledModel, compile  # noqa: E402

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
-from ..core.flatmodel import FlatVariable
+from ..core.flatmodel import FlatVariable, HybridPart
 from ..core.variables import TIME
 from ..errors import ParameterError
 from ..passes.sorting import SortedDAE
@@ -43,18 +43,31 @@ class CasadiDAE:
     fixed: list[tuple[int, float]]          # (index in names, value) of fixed start values
     observed_index: dict[str, int]
     cache: dict = field(default_factory=dict, repr=False)   # CasADi functions built on demand
+    discretes: list[FlatVariable] = field(default_factory=list)  # slots at the end of p
+    hybrid: HybridPart | None = None      # SX in terms of t, x, z, p
+    n_variables: int = 0                  # names[:n_variables] are continuous-time variables
+    discrete_names: set[str] = field(default_factory=set)     # discrete-valued variables
+    differentiated: set[str] = field(default_factory=set)     # variables x with der(x)
+    aliases: dict[str, tuple[str, float]] = field(default_factory=dict)
+
+    @property
+    def n_base(self) -> int:
+        """Index of the first discrete slot in ``p`` (parameters and inputs come first)."""
+        return len(self.parameters) + len(self.inputs)
 
     @property
     def p_default(self) -> np.ndarray:
         vals = [float(p.decl.value) for p in self.parameters]
         vals += [float(u.decl.start) for u in self.inputs]
+        vals += [float(d.decl.start) for d in self.discretes]
         return np.array(vals, dtype=float)
 
     def p_vector(self, overrides: dict[str, float] | None = None) -> np.ndarray:
         """Parameter-and-input vector with ``overrides`` applied (by dotted name)."""
         vec = self.p_default
         if overrides:
-            names = [p.name for p in self.parameters] + [u.name for u in self.inputs]
+            names = [p.name for p in self.parameters] + [u.name for u in self.inputs] \
+                + [d.name for d in self.discretes]
             where = {n: k for k, n in enumerate(names)}
             for key, value in overrides.items():
                 if key not in where:
@@ -94,7 +107,9 @@ def build_dae(sorted_dae: SortedDAE) -> CasadiDAE:
         d = variables[j].der
         ode_raw.append(variables[d].sx)
     obs_raw = [v.sx for v in variables]
-    targets = ca.vertcat(*(ode_raw + list(sorted_dae.residuals) + obs_raw))
+    hybrid = model.hybrid
+    extra = hybrid.expressions() if hybrid is not None else []
+    targets = ca.vertcat(*(ode_raw + list(sorted_dae.residuals) + obs_raw + extra))
     if vsym:
         _, (targets,) = ca.substitute_inplace([ca.vertcat(*vsym)], [ca.vertcat(*vdef)],
                                               [targets], False)
@@ -105,13 +120,22 @@ def build_dae(sorted_dae: SortedDAE) -> CasadiDAE:
     n_x, n_r = len(states), len(sorted_dae.residuals)
     ode = targets[:n_x]
     alg = targets[n_x:n_x + n_r]
-    observed = targets[n_x + n_r:]
+    n_obs = len(obs_raw)
+    observed = targets[n_x + n_r:n_x + n_r + n_obs]
+    if hybrid is not None:
+        rest = targets[n_x + n_r + n_obs:]
+        hybrid = hybrid.with_expressions([rest[k] for k in range(rest.numel())])
+    shown = [d for d in model.discretes if not d.name.startswith(("$", "pre(", "initial()",
+                                                                  "terminal()"))]
+    if shown:
+        observed = ca.vertcat(observed, *[d.sx for d in shown])
 
-    names = [v.name for v in variables]
+    names = [v.name for v in variables] + [d.name for d in shown]
     observed_index = {n: k for k, n in enumerate(names)}
     fixed = [(k, float(v.decl.start)) for k, v in enumerate(variables)
              if v.der_of < 0 and getattr(v.decl, "fixed", False)]
-    p = ca.vertcat(*[q.sx for q in free_params], *[u.sx for u in model.inputs])
+    p = ca.vertcat(*[q.sx for q in free_params], *[u.sx for u in model.inputs],
+                   *[d.sx for d in model.discretes])
     return CasadiDAE(
         x=ca.vertcat(*[variables[j].sx for j in states]),
         z=ca.vertcat(*[variables[j].sx for j in alg_vars]),
@@ -121,7 +145,11 @@ def build_dae(sorted_dae: SortedDAE) -> CasadiDAE:
         parameters=free_params, inputs=list(model.inputs),
         x_start=np.array([_start(variables[j]) for j in states], dtype=float),
         z_start=np.array([_start(variables[j]) for j in alg_vars], dtype=float),
-        fixed=fixed, observed_index=observed_index)
+        fixed=fixed, observed_index=observed_index, discretes=list(model.discretes),
+        hybrid=hybrid, n_variables=len(variables),
+        discrete_names={v.name for v in variables if v.decl.kind == "discrete"}
+        | {d.name for d in shown},
+        differentiated={v.name for v in variables if v.der >= 0}, aliases=dict(model.aliases))
 
 
 def _start(v: FlatVariable) -> float:

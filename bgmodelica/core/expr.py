@@ -53,11 +53,18 @@ class Expr:
     def __ne__(self, o):  # type: ignore[override]
         return _binary("!=", self, o)
 
+    def __and__(self, o): return _binary("and", self, o)
+    def __rand__(self, o): return _binary("and", o, self)
+    def __or__(self, o): return _binary("or", self, o)
+    def __ror__(self, o): return _binary("or", o, self)
+    def __invert__(self): return Op("not", (self,))
+
     __hash__ = object.__hash__
 
     def __bool__(self) -> bool:
-        raise TypeError("a symbolic expression has no truth value; use if_else() for "
-                        "conditions and '==' only to write equations")
+        raise TypeError("a symbolic expression has no truth value: use if_else() or when() "
+                        "for conditions, '&', '|', '~' instead of 'and', 'or', 'not', eq(a, b) "
+                        "to compare, and '==' only to write equations")
 
     def __SX__(self) -> ca.SX:
         return to_sx(self)
@@ -101,7 +108,17 @@ class Equation:
         return f"{to_text(self.lhs)} == {to_text(self.rhs)}"
 
 
+#: relation operators; outside ``no_event`` they become zero-crossing functions
+RELATIONS = ("<", "<=")
+#: operators whose value is Boolean
+BOOLEAN_OPS = ("<", "<=", "!=", "==", "and", "or", "not")
+#: number of relation and hybrid nodes ever created (0: no model can contain any)
+HYBRID_NODES = [0]
+
+
 def _binary(op: str, a: Any, b: Any) -> Any:
+    if op in BOOLEAN_OPS:
+        HYBRID_NODES[0] += 1
     if isinstance(a, (ca.SX, ca.MX)) or isinstance(b, (ca.SX, ca.MX)):
         return _SX_BINARY[op](to_sx(a), to_sx(b))
     if isinstance(a, Number):
@@ -189,11 +206,13 @@ def if_else(condition: Any, then: Any, otherwise: Any) -> Any:
 _SX_BINARY: dict[str, Callable[[Any, Any], Any]] = {
     "+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b,
     "/": lambda a, b: a / b, "**": lambda a, b: a ** b, "<": lambda a, b: a < b,
-    "<=": lambda a, b: a <= b, "!=": lambda a, b: a != b,
+    "<=": lambda a, b: a <= b, "!=": lambda a, b: a != b, "==": ca.eq,
+    "and": ca.logic_and, "or": ca.logic_or,
     "atan2": ca.atan2, "fmin": ca.fmin, "fmax": ca.fmax,
 }
 _SX_UNARY: dict[str, Callable[[Any], Any]] = {
-    "neg": lambda a: -a, "fabs": ca.fabs, "sign": ca.sign,
+    "neg": lambda a: -a, "fabs": ca.fabs, "sign": ca.sign, "not": ca.logic_not,
+    "noEvent": lambda a: a, "floor": ca.floor, "ceil": ca.ceil,
     **{n: getattr(ca, n) for n in ("sin", "cos", "tan", "exp", "log", "sqrt", "asin", "acos",
                                    "atan", "sinh", "cosh", "tanh")},
 }
@@ -304,6 +323,7 @@ def differentiate(e: Any, rate: Callable[[Any], Any]) -> Any:
         "fmin": lambda: if_else(a[0] <= a[1], d[0], d[1]),
         "fmax": lambda: if_else(a[1] <= a[0], d[0], d[1]),
         "if_else": lambda: if_else(a[0], d[1], d[2]),
+        "noEvent": lambda: d[0],
     }
     if op in chain:
         return chain[op]()
@@ -313,7 +333,7 @@ def differentiate(e: Any, rate: Callable[[Any], Any]) -> Any:
 # -- printing -----------------------------------------------------------------------------------
 
 _INFIX = {"+": " + ", "-": " - ", "*": "*", "/": "/", "**": "^", "<": " < ", "<=": " <= ",
-          "!=": " != "}
+          "!=": " <> ", "==": " == ", "and": " and ", "or": " or "}
 
 
 def to_text(e: Any) -> str:
@@ -327,5 +347,7 @@ def to_text(e: Any) -> str:
             return f"({to_text(e.args[0])}{_INFIX[e.op]}{to_text(e.args[1])})"
         if e.op == "neg":
             return f"-{to_text(e.args[0])}"
+        if e.op == "not":
+            return f"not {to_text(e.args[0])}"
         return f"{e.op}({', '.join(to_text(a) for a in e.args)})"
     return str(e)

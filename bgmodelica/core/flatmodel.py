@@ -75,6 +75,8 @@ class FlatModel:
     inputs: list[FlatVariable]
     equations: list[FlatEquation]
     aliases: dict[str, tuple[str, float]] = field(default_factory=dict)
+    discretes: list[FlatVariable] = field(default_factory=list)
+    hybrid: HybridPart | None = None
 
     def index(self) -> dict[str, int]:
         """Name -> index in :attr:`variables`."""
@@ -90,6 +92,7 @@ class FlatModel:
         out = {v.sx.element_hash(): v.name for v in self.variables}
         out.update((p.sx.element_hash(), p.name) for p in self.parameters)
         out.update((u.sx.element_hash(), u.name) for u in self.inputs)
+        out.update((d.sx.element_hash(), d.name) for d in self.discretes)
         return out
 
     def describe(self, k: int) -> str:
@@ -98,3 +101,106 @@ class FlatModel:
 
     def parameter_values(self) -> dict[str, object]:
         return {p.name: p.decl.value for p in self.parameters}
+
+
+# -- the hybrid part: relations, when-clauses, clocks and tables (slots index ``discretes``) -----
+
+
+@dataclass
+class FlatRelation:
+    """A relation frozen between events: ``indicator > 0`` (strict) or ``>= 0`` holds.
+
+    slot: index in :attr:`FlatModel.discretes` of its value (0/1). time_only: the indicator
+    depends on time, parameters and discrete values only (a time event).
+    """
+
+    slot: int
+    indicator: ca.SX
+    strict: bool
+    text: str
+    origin: str
+    time_only: bool = False
+
+
+@dataclass
+class FlatBranch:
+    """One ``when``/``elsewhen`` branch: Boolean ``condition``, assignments
+    ``(discrete slot, value)`` and reinits ``(variable name, value)``."""
+
+    condition: ca.SX
+    text: str
+    assignments: list[tuple[int, ca.SX]]
+    reinits: list[tuple[str, ca.SX]]
+
+
+@dataclass
+class FlatWhen:
+    branches: list[FlatBranch]
+    origin: str
+
+
+@dataclass
+class FlatSample:
+    """``sample(start, interval)``: slot true at ``start + k*interval`` (expressions of
+    parameters)."""
+
+    slot: int
+    start: ca.SX
+    interval: ca.SX
+    origin: str
+
+
+@dataclass
+class FlatTable:
+    """A time table: the expression ``c0 + c1*time`` with coefficients in two slots."""
+
+    c0: int
+    c1: int
+    times: object          # numpy arrays
+    values: object
+    interpolation: str
+    extrapolation: str
+    origin: str
+
+
+@dataclass
+class HybridPart:
+    """Everything event-related in a flat model. ``pre`` lists ``(slot, variable name)``:
+    the slot holds the variable's left limit; ``initial``/``terminal`` are slots or -1."""
+
+    relations: list[FlatRelation] = field(default_factory=list)
+    whens: list[FlatWhen] = field(default_factory=list)
+    samples: list[FlatSample] = field(default_factory=list)
+    tables: list[FlatTable] = field(default_factory=list)
+    pre: list[tuple[int, str]] = field(default_factory=list)
+    initial: int = -1
+    terminal: int = -1
+
+    def expressions(self) -> list[ca.SX]:
+        """Every SX held, in a fixed order (see :meth:`with_expressions`)."""
+        out = [r.indicator for r in self.relations]
+        for w in self.whens:
+            for b in w.branches:
+                out.append(b.condition)
+                out += [v for _, v in b.assignments] + [v for _, v in b.reinits]
+        for s in self.samples:
+            out += [s.start, s.interval]
+        return out
+
+    def with_expressions(self, exprs: list[ca.SX]) -> HybridPart:
+        """A copy holding ``exprs`` (same order as :meth:`expressions`)."""
+        it = iter(exprs)
+        rels = [FlatRelation(r.slot, next(it), r.strict, r.text, r.origin, r.time_only)
+                for r in self.relations]
+        whens = []
+        for w in self.whens:
+            branches = []
+            for b in w.branches:
+                cond = next(it)
+                assigns = [(s, next(it)) for s, _ in b.assignments]
+                reinits = [(n, next(it)) for n, _ in b.reinits]
+                branches.append(FlatBranch(cond, b.text, assigns, reinits))
+            whens.append(FlatWhen(branches, w.origin))
+        samples = [FlatSample(s.slot, next(it), next(it), s.origin) for s in self.samples]
+        return HybridPart(rels, whens, samples, list(self.tables), list(self.pre),
+                          self.initial, self.terminal)

@@ -18,8 +18,9 @@ from typing import Any
 import casadi as ca
 
 from ..errors import ConnectError, DeclarationError, EquationError
+from . import flatten_hybrid
 from .component import Component, Connection, Connector, Element
-from .expr import Equation, Expr, Leaf, Number, lower_group, shape_of, to_sx
+from .expr import HYBRID_NODES, Equation, Expr, Leaf, Number, lower_group, shape_of, to_sx
 from .flatmodel import FlatEquation, FlatModel, FlatVariable
 from .variables import (
     KIND_FLOW,
@@ -49,6 +50,9 @@ class _Flattener:
         self.var_of: dict[int, int] = {}         # id(Symbol) -> variable index
         self.pos: dict[int, int] = {}            # id(Symbol) -> position in self.all_sx
         self.equations: list[FlatEquation] = []
+        self.draft: flatten_hybrid.HybridDraft | None = None
+        self.slot: dict[int, int] = {}            # id(Symbol) -> index in discretes
+        self.full: dict[int, str] = {}            # id(Symbol) -> dotted name
 
     # -- tree walk -------------------------------------------------------------------------
     def run(self, name: str) -> FlatModel:
@@ -71,12 +75,20 @@ class _Flattener:
                         self.pending.append((eq, elem))
             for child_name, child in reversed(list(elem._children.items())):
                 stack.append((child, _join(path, child_name), elem))
-        variables, parameters, inputs, symbols = self._collect_symbols()
+        if HYBRID_NODES[0]:
+            self.pending, draft = flatten_hybrid.extract(self.pending, self.where)
+            self.draft = None if draft.empty else draft
+        variables, parameters, inputs, discretes, symbols = self._collect_symbols()
         self._bind(symbols)
         self._connection_equations()
         self._component_equations()
         parameters = [self._lower_binding(p) for p in parameters]
-        return FlatModel(name, variables, parameters, inputs, self.equations)
+        hybrid = None
+        if self.draft is not None:
+            hybrid = flatten_hybrid.lower(self.draft, lambda s: self.slot[id(s)],
+                                          lambda s: self.full[id(s)])
+        return FlatModel(name, variables, parameters, inputs, self.equations,
+                         discretes=discretes, hybrid=hybrid)
 
     def where(self, elem: Element) -> str:
         return f"{self.paths[id(elem)] or 'top level'} ({type(elem).__name__})"
@@ -86,7 +98,9 @@ class _Flattener:
         variables: list[FlatVariable] = []
         parameters: list[FlatVariable] = []
         inputs: list[FlatVariable] = []
+        discretes: list[FlatVariable] = []
         symbols: list[tuple[Symbol, list, int]] = []      # (symbol, target list, index)
+        targets = self.draft.targets if self.draft is not None else {}
         top_connectors = {id(c) for c in self.top._children.values() if isinstance(c, Connector)}
         for elem in self.elements:
             path = self.paths[id(elem)]
@@ -94,7 +108,12 @@ class _Flattener:
             for sym in elem._symbols.values():
                 full = _join(path, sym.name)
                 kind = sym.decl.kind
-                if kind == KIND_PARAMETER:
+                self.full[id(sym)] = full
+                if id(sym) in targets:
+                    self.slot[id(sym)] = len(discretes)
+                    symbols.append((sym, discretes, len(discretes)))
+                    discretes.append(FlatVariable(full, None, sym.decl, owner))
+                elif kind == KIND_PARAMETER:
                     symbols.append((sym, parameters, len(parameters)))
                     parameters.append(FlatVariable(full, None, sym.decl, owner))
                 elif kind == KIND_INPUT and (elem is self.top or id(elem) in top_connectors):
@@ -112,7 +131,20 @@ class _Flattener:
                         symbols.append((sym, variables, len(variables)))
                         variables.append(FlatVariable(full, None, sym.decl, owner, der_of=below))
                         below = len(variables) - 1
-        return variables, parameters, inputs, symbols
+        if self.draft is not None:
+            for k, sym in enumerate(self.draft.hidden()):
+                if sym.pre_of is not None:
+                    owner = self.full.get(id(sym.pre_of))
+                    if owner is None:
+                        raise DeclarationError(f"pre({sym.pre_of.name}) refers to a variable "
+                                               "that is not part of the model")
+                    name = f"pre({owner})"
+                else:
+                    name = _hidden_name(sym, k)
+                self.slot[id(sym)] = len(discretes)
+                symbols.append((sym, discretes, len(discretes)))
+                discretes.append(FlatVariable(name, None, sym.decl, ""))
+        return variables, parameters, inputs, discretes, symbols
 
     def _bind(self, symbols) -> None:
         """Give every symbol an SX scalar: fresh ones become elements of one SX vector."""
@@ -395,6 +427,14 @@ def _leaf_symbols(e: Any) -> list:
     leaves: list = []
     shape_of(e, leaves, [])
     return leaves
+
+
+def _hidden_name(sym: Symbol, k: int) -> str:
+    if isinstance(sym, flatten_hybrid.RelationSlot):
+        return f"$relation{k}"
+    if sym.name.endswith("()"):
+        return sym.name
+    return f"${sym.name}{k}"
 
 
 def _join(path: str, name: str) -> str:

@@ -35,6 +35,7 @@ KIND_POTENTIAL = "potential"
 KIND_FLOW = "flow"
 KIND_INPUT = "input"
 KIND_OUTPUT = "output"
+KIND_DISCRETE = "discrete"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -127,6 +128,40 @@ class Output(Variable):
     kind = KIND_OUTPUT
 
 
+@dataclass(frozen=True)
+class Discrete(Variable):
+    """A discrete-time Real: constant between events, changed only at event instants.
+
+    Assigned inside ``when(...)`` (a discrete state, whose ``start`` is its value before the
+    first event) or defined by an ordinary equation of relations and ``pre()`` values
+    (evaluated at every event iteration). ``start`` is also the initial ``pre`` value.
+    """
+
+    kind = KIND_DISCRETE
+    type_name = "Real"
+
+    def with_start(self, value: Any) -> Discrete:
+        if isinstance(value, dict):
+            return super().with_start(value)   # type: ignore[return-value]
+        return replace(self, start=value, fixed=True)
+
+
+@dataclass(frozen=True)
+class Integer(Discrete):
+    """A discrete Integer (e.g. a mode or a counter); see :class:`Discrete`."""
+
+    start: float = 0
+    type_name = "Integer"
+
+
+@dataclass(frozen=True)
+class Boolean(Discrete):
+    """A discrete Boolean (stored as 0/1); see :class:`Discrete`."""
+
+    start: float = False
+    type_name = "Boolean"
+
+
 class Symbol:
     """One declared scalar of one component instance.
 
@@ -136,15 +171,19 @@ class Symbol:
     ``der`` (the Symbol of its time derivative).
     """
 
-    __slots__ = ("name", "decl", "_sx", "owner", "der", "der_of", "leaf", "__weakref__")
+    __slots__ = ("name", "decl", "_sx", "owner", "der", "der_of", "pre", "pre_of", "leaf",
+                 "__weakref__")
 
-    def __init__(self, name: str, decl: Declaration, owner: Any, der_of: Symbol | None = None):
+    def __init__(self, name: str, decl: Declaration, owner: Any, der_of: Symbol | None = None,
+                 pre_of: Symbol | None = None):
         self.name = name
         self.decl = decl
         self._sx: ca.SX | None = None
         self.owner = owner
         self.der: Symbol | None = None
         self.der_of = der_of
+        self.pre: Symbol | None = None
+        self.pre_of = pre_of
         self.leaf = Leaf(self)
 
     @property
@@ -167,6 +206,20 @@ class Symbol:
             self.der = Symbol(f"der({self.name})", Variable(unit=derivative_unit(self.decl.unit)),
                               self.owner, der_of=self)
         return self.der
+
+    def previous(self) -> Symbol:
+        """The symbol of ``pre(self)``: the left limit at an event instant (created once)."""
+        if self.decl.kind == KIND_PARAMETER:
+            raise DeclarationError(f"pre() of parameter {self.name!r}: parameters are constant")
+        if self.pre is None:
+            start = getattr(self.decl, "start", 0.0)
+            self.pre = Symbol(f"pre({self.name})", Discrete(unit=self.decl.unit, start=start),
+                              self.owner, pre_of=self)
+        return self.pre
+
+    @property
+    def is_discrete(self) -> bool:
+        return self.decl is not None and self.decl.kind == KIND_DISCRETE
 
     def __repr__(self) -> str:
         return f"Symbol({self.name!r}, {type(self.decl).__name__})"

@@ -61,12 +61,17 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
 
     kept = [eq for k, eq in enumerate(model.equations) if k not in used]
     residuals: list[ca.SX] = []
-    if kept:
-        targets = ca.vertcat(*[eq.residual for eq in kept])
+    hybrid = model.hybrid
+    extra = hybrid.expressions() if hybrid is not None else []
+    if kept or extra:
+        targets = ca.vertcat(*[eq.residual for eq in kept], *extra)
         if old:
             targets = ca.substitute(targets, ca.vertcat(*old),
                                     ca.vertcat(*new_rep) * ca.DM(new_sign))
-        residuals = ca.vertsplit(targets) if len(kept) > 1 else [targets]
+        parts = ca.vertsplit(targets) if targets.numel() > 1 else [targets]
+        residuals = parts[:len(kept)]
+        if hybrid is not None:
+            hybrid = hybrid.with_expressions(parts[len(kept):])
     equations = [FlatEquation(res, eq.origin) for res, eq in zip(residuals, kept, strict=True)]
     keep_idx = [i for i in range(len(new_vars)) if i not in eliminated]
     remap = {old_i: new_i for new_i, old_i in enumerate(keep_idx)}
@@ -74,7 +79,8 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
     for i in keep_idx:
         v = new_vars[i]
         final.append(replace(v, der=remap.get(v.der, -1), der_of=remap.get(v.der_of, -1)))
-    return FlatModel(model.name, final, model.parameters, model.inputs, equations, aliases)
+    return FlatModel(model.name, final, model.parameters, model.inputs, equations, aliases,
+                     model.discretes, hybrid)
 
 
 def _ensure_derivative(variables: list[FlatVariable], i: int) -> int:

@@ -94,7 +94,7 @@ def reduce_index(model: FlatModel | ReducedModel,
         rows[n_old:] = incidence([e.residual for e in equations[n_old:]],
                                  [v.sx for v in variables])
     aug = FlatModel(model.name, variables, model.parameters, model.inputs, equations,
-                    model.aliases)
+                    model.aliases, model.discretes, model.hybrid)
     eq_derivative = (links + [-1] * (len(equations) - len(links))) if links \
         else [-1] * len(equations)
     for new, of in pant.new_equations:

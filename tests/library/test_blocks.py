@@ -62,7 +62,12 @@ def test_delayed_step_and_ramp_sources():
     m.connect(m.c.y, m.g.u)
     result = bg.simulate(m, stop_time=4.0, interval=0.25, **TIGHT)
     t = result.time
-    assert np.allclose(result["s.y"], np.where(t >= 0.5, 1.0, -1.0), rtol=0, atol=1e-12)
+    # the step is a time event: two rows at t = 0.5, the left limit (-1) then the right (1)
+    k = int(np.nonzero(t == 0.5)[0][0])
+    assert t[k + 1] == 0.5 and result.meta["event_times"] == [0.5]
+    right = np.where(t > 0.5, 1.0, -1.0)
+    right[k + 1] = 1.0
+    assert np.allclose(result["s.y"], right, rtol=0, atol=1e-12)
     ramp = 1.0 + 4.0 * np.clip((t - 1.0) / 2.0, 0, 1)
     assert np.allclose(result["r.y"], ramp, rtol=0, atol=1e-12)
 

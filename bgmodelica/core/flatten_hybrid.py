@@ -1,0 +1,242 @@
+"""The hybrid part of flattening: relations become frozen slots, when-clauses and if-equations
+are taken apart, and every hidden discrete symbol (``pre``, relation values, sample clocks,
+table coefficients, ``initial()``) is found.
+
+:func:`extract` runs on the raw equations before symbols are bound; :func:`lower` turns the
+draft into a :class:`~bgmodelica.core.flatmodel.HybridPart` once every symbol has its SX.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import casadi as ca
+
+from ..errors import EquationError
+from .expr import RELATIONS, Equation, Expr, Leaf, Op, to_sx, to_text
+from .flatmodel import FlatBranch, FlatRelation, FlatSample, FlatTable, FlatWhen, HybridPart
+from .hybrid import _INITIAL, _TERMINAL, IfEquation, Reinit, SampleClock, TimeTable, When, _Special
+from .variables import KIND_PARAMETER, TIME, Boolean, Symbol
+
+
+class RelationSlot(_Special):
+    """The frozen value of one relation ``a < b`` / ``a <= b``."""
+
+    __slots__ = ("op", "a", "b", "where")
+
+    def __init__(self, op: str, a: Any, b: Any, where: str) -> None:
+        super().__init__(f"({to_text(a)} {op} {to_text(b)})", Boolean(), None)
+        self.op, self.a, self.b, self.where = op, a, b, where
+
+
+@dataclass
+class HybridDraft:
+    """What :func:`extract` found, keyed by symbol identity."""
+
+    whens: list[tuple[When, str]] = field(default_factory=list)
+    relations: list[RelationSlot] = field(default_factory=list)
+    specials: dict[int, _Special] = field(default_factory=dict)    # samples, tables, initial
+    pres: dict[int, Symbol] = field(default_factory=dict)          # pre(...) symbols
+    targets: dict[int, Symbol] = field(default_factory=dict)       # assigned in when
+    target_where: dict[int, str] = field(default_factory=dict)
+
+    @property
+    def empty(self) -> bool:
+        return not (self.whens or self.relations or self.specials or self.pres)
+
+    def hidden(self) -> list[Symbol]:
+        """Slots to add to the model's discrete vector, in a fixed order."""
+        out: list[Symbol] = list(self.relations)
+        for s in self.specials.values():
+            out.append(s)
+            if isinstance(s, TimeTable):
+                out.append(s.c1)
+        return out + list(self.pres.values())
+
+
+def extract(pending: list[tuple[Any, Any]], where: Callable[[Any], str]
+            ) -> tuple[list[tuple[Any, Any]], HybridDraft]:
+    """Rewrite ``pending`` ``(statement, component)`` pairs: relations outside ``no_event``
+    on continuous quantities become relation slots; if-equations become residual equations;
+    when-clauses move to the draft."""
+    draft = HybridDraft()
+    out: list[tuple[Any, Any]] = []
+    rw = _Rewriter(draft)
+    for eq, ctx in pending:
+        here = where(ctx)
+        if isinstance(eq, When):
+            for cond, stmts in eq.branches:
+                rw.scan(cond, here, live=True)
+                for s in stmts:
+                    if isinstance(s, Reinit):
+                        rw.scan(s.value, here, live=False)
+                        continue
+                    target = s.lhs.sym if isinstance(s.lhs, Leaf) else None
+                    if not isinstance(target, Symbol) or not target.is_discrete:
+                        raise EquationError(
+                            f"{here}: in when(), {s!r} must assign a discrete variable "
+                            "(Discrete, Integer or Boolean) on its left side; use reinit() for "
+                            "continuous variables")
+                    if id(target) in draft.targets and draft.target_where[id(target)] != here:
+                        raise EquationError(
+                            f"{here}: {target.name} is also assigned in when() of "
+                            f"{draft.target_where[id(target)]}; a discrete variable is assigned "
+                            "in one when-clause only")
+                    draft.targets[id(target)] = target
+                    draft.target_where[id(target)] = here
+                    rw.scan(s.rhs, here, live=False)
+            draft.whens.append((eq, here))
+            continue
+        if isinstance(eq, IfEquation):
+            for e in _if_residuals(eq, here):
+                out.append((Equation(rw.rewrite(e.lhs, here), 0.0), ctx))
+            continue
+        if isinstance(eq, Equation) and isinstance(eq.lhs, (Expr, float, int)) \
+                and isinstance(eq.rhs, (Expr, float, int)):
+            out.append((Equation(rw.rewrite(eq.lhs, here), rw.rewrite(eq.rhs, here)), ctx))
+            continue
+        if isinstance(eq, Reinit):
+            raise EquationError(f"{here}: reinit({eq.target.name}, ...) belongs inside when()")
+        out.append((eq, ctx))
+    for cond_when, here in draft.whens:
+        cond_when.branches[:] = [(rw.rewrite(c, here), stmts)
+                                 for c, stmts in cond_when.branches]
+    return out, draft
+
+
+def _if_residuals(eq: IfEquation, here: str) -> list[Equation]:
+    sizes = {len(eqs) for _, eqs in eq.branches} | {len(eq.otherwise)}
+    if len(sizes) != 1:
+        counts = ", ".join(str(len(eqs)) for _, eqs in eq.branches)
+        raise EquationError(
+            f"{here}: if-equation branches must have the same number of equations (then/elseif: "
+            f"{counts}; else: {len(eq.otherwise)})")
+    out = []
+    for k in range(len(eq.otherwise)):
+        res = _residual(eq.otherwise[k], here)
+        for cond, eqs in reversed(eq.branches):
+            res = Op("if_else", (cond if isinstance(cond, Expr) else float(cond),
+                                 _residual(eqs[k], here), res))
+        out.append(Equation(res, 0.0))
+    return out
+
+
+def _residual(e: Any, here: str) -> Any:
+    if not isinstance(e, Equation):
+        raise EquationError(f"{here}: an if-equation branch holds equations 'a == b', got {e!r}")
+    lhs = e.lhs if isinstance(e.lhs, Expr) else float(e.lhs)
+    rhs = e.rhs if isinstance(e.rhs, Expr) else float(e.rhs)
+    return lhs - rhs
+
+
+class _Rewriter:
+    def __init__(self, draft: HybridDraft) -> None:
+        self.draft = draft
+        self.memo: dict[tuple[int, bool], Any] = {}
+        self.rel_memo: dict[tuple, RelationSlot] = {}
+
+    def scan(self, e: Any, here: str, live: bool) -> None:
+        """Record hidden symbols used in ``e`` (no rewriting)."""
+        self._walk(e, here, live=False, rewrite=False)
+
+    def rewrite(self, e: Any, here: str) -> Any:
+        return self._walk(e, here, live=True, rewrite=True)
+
+    def _walk(self, e: Any, here: str, live: bool, rewrite: bool) -> Any:
+        if not isinstance(e, Expr):
+            return e
+        key = (id(e), live and rewrite)
+        if key in self.memo:
+            return self.memo[key]
+        if isinstance(e, Leaf):
+            self._note(e.sym)
+            out: Any = e
+        elif e.op == "noEvent":
+            out = Op("noEvent", (self._walk(e.args[0], here, False, rewrite),))
+        elif e.op in RELATIONS and live and rewrite and (_continuous(e.args[0])
+                                                          or _continuous(e.args[1])):
+            a = self._walk(e.args[0], here, live, rewrite)
+            b = self._walk(e.args[1], here, live, rewrite)
+            rk = (e.op, id(a), id(b))
+            slot = self.rel_memo.get(rk)
+            if slot is None:
+                slot = RelationSlot(e.op, a, b, here)
+                self.rel_memo[rk] = slot
+                self.draft.relations.append(slot)
+            out = slot.leaf
+        else:
+            args = tuple(self._walk(a, here, live, rewrite) for a in e.args)
+            out = e if all(x is y for x, y in zip(args, e.args, strict=True)) \
+                else Op(e.op, args)
+        self.memo[key] = out
+        return out
+
+    def _note(self, sym: Any) -> None:
+        if isinstance(sym, (SampleClock, TimeTable)) or sym is _INITIAL or sym is _TERMINAL:
+            self.draft.specials.setdefault(id(sym), sym)
+            if isinstance(sym, SampleClock):
+                self.scan(sym.start, "", False)
+                self.scan(sym.interval, "", False)
+        elif isinstance(sym, Symbol) and sym.pre_of is not None:
+            self.draft.pres.setdefault(id(sym), sym)
+
+
+def _continuous(e: Any) -> bool:
+    """Whether ``e`` depends on time or a continuous-time variable."""
+    if isinstance(e, Leaf):
+        sym = e.sym
+        if sym is TIME:
+            return True
+        decl = getattr(sym, "decl", None)
+        return decl is not None and decl.kind != KIND_PARAMETER and not sym.is_discrete
+    if isinstance(e, Op):
+        return any(_continuous(a) for a in e.args)
+    return False
+
+
+def lower(draft: HybridDraft, slot_of: Callable[[Symbol], int],
+          name_of: Callable[[Symbol], str]) -> HybridPart:
+    """The :class:`HybridPart` of a draft whose symbols are bound (``slot_of`` gives a hidden
+    or discrete symbol's index in the model's discrete vector, ``name_of`` a variable's
+    dotted name)."""
+    part = HybridPart()
+    for r in draft.relations:
+        a, b = to_sx(r.a), to_sx(r.b)
+        ind = ca.SX(b - a)
+        text = f"{to_text(r.a)} {r.op} {to_text(r.b)}"
+        part.relations.append(FlatRelation(slot_of(r), ind, r.op == "<", text, r.where,
+                                           _time_only(r.a) and _time_only(r.b)))
+    for w, here in draft.whens:
+        branches = []
+        for cond, stmts in w.branches:
+            assigns, reinits = [], []
+            for s in stmts:
+                if isinstance(s, Reinit):
+                    reinits.append((name_of(s.target), to_sx(s.value)))
+                else:
+                    assigns.append((slot_of(s.lhs.sym), to_sx(s.rhs)))
+            branches.append(FlatBranch(to_sx(cond), to_text(cond), assigns, reinits))
+        part.whens.append(FlatWhen(branches, here))
+    part.pre = [(slot_of(p), name_of(p.pre_of)) for p in draft.pres.values()]
+    for s in draft.specials.values():
+        if isinstance(s, SampleClock):
+            part.samples.append(FlatSample(slot_of(s), to_sx(s.start), to_sx(s.interval), ""))
+        elif isinstance(s, TimeTable):
+            part.tables.append(FlatTable(slot_of(s), slot_of(s.c1), s.times, s.values,
+                                         s.interpolation, s.extrapolation, ""))
+        elif s is _INITIAL:
+            part.initial = slot_of(s)
+        elif s is _TERMINAL:
+            part.terminal = slot_of(s)
+    return part
+
+
+def _time_only(e: Any) -> bool:
+    """No continuous-time variable in ``e`` (time, parameters and discrete values only)."""
+    if isinstance(e, Leaf):
+        return e.sym is TIME or not _continuous(e)
+    if isinstance(e, Op):
+        return all(_time_only(a) for a in e.args)
+    return True

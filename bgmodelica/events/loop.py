@@ -1,0 +1,527 @@
+"""The event loop: integrate between events, locate state events, hit time events exactly,
+iterate the discrete equations to a fixed point, re-initialize, restart.
+
+Continuous phases run on CasADi's SUNDIALS integrators (CVODES for ODEs, IDAS for DAEs) in a
+time-scaled form ``x' = dt*f(t0 + tau*dt, ...)`` over ``tau`` in [0, 1], so one integrator
+serves every segment. A segment ends at the next output point, time event or stop time. The
+state-event indicators are checked at ``checks`` points inside each segment; a crossing
+(a relation whose value differs from its frozen value) is bracketed and located by the
+Illinois method on re-integrations from the bracket's start, to ``event_tol`` in time. The
+event is taken at the right end of the bracket, where the relation has its new value.
+
+At every event the result gets two rows with the same time: the left limit (values before
+the event) and the right limit (after the event iteration and re-initialization).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from ..backends.casadi_dae import CasadiDAE
+from ..backends.casadi_init import initialize
+from ..errors import SimulationError
+from .functions import HybridFunctions, build
+from .schedule import is_sample_instant, next_sample, table_coefficients
+
+
+class EventError(SimulationError):
+    """Event handling failed: the event iteration did not converge, or events chatter."""
+
+
+@dataclass
+class EventOptions:
+    """max_iterations: event-iteration bound; checks: indicator checks per segment;
+    event_tol: time tolerance of state-event location [s] (relative to max(1, |t|));
+    zeno_events: consecutive events closer than ``zeno_dt`` that count as chattering."""
+
+    max_iterations: int = 100
+    checks: int = 8
+    event_tol: float = 1e-13
+    zeno_events: int = 50
+    zeno_dt: float = 1e-10
+
+
+@dataclass
+class EventLog:
+    times: list[float] = field(default_factory=list)
+    kinds: list[str] = field(default_factory=list)
+    causes: dict[str, int] = field(default_factory=dict)
+
+
+class HybridSimulator:
+    """Simulate one hybrid model for one parameter vector (see the module docstring)."""
+
+    def __init__(self, dae: CasadiDAE, p: np.ndarray, rtol: float, atol: float,
+                 max_step: float | None, max_steps: int, obs_idx: list[int],
+                 options: EventOptions | None = None) -> None:
+        self.dae = dae
+        self.fn: HybridFunctions = build(dae)
+        self.p = np.array(p, dtype=float)
+        self.opts = options or EventOptions()
+        self.obs_idx = obs_idx
+        self.log = EventLog()
+        self.stats: dict[str, float] = {}
+        sol_opts: dict[str, Any] = {"abstol": atol, "reltol": rtol, "max_num_steps": max_steps}
+        if max_step is not None:
+            sol_opts["max_step_size"] = float(max_step)
+        self._sol_opts = sol_opts
+        self._opts_key = tuple(sorted(sol_opts.items()))
+        self._one: ca.Function | None = None
+        hyb = dae.hybrid
+        nb = dae.n_base
+        self.sample_slots = [nb + s.slot for s in hyb.samples]
+        fp = ca.Function("sample_times", [dae.p], [ca.vertcat(
+            *[ca.vertcat(s.start, s.interval) for s in hyb.samples])] if hyb.samples
+            else [ca.SX(0, 1)])
+        st = np.asarray(fp(self.p)).ravel()
+        self.samples = [(float(st[2 * k]), float(st[2 * k + 1]), self.sample_slots[k])
+                        for k in range(len(hyb.samples))]
+        for start, interval, _ in self.samples:
+            if not (math.isfinite(start) and math.isfinite(interval) and interval > 0):
+                raise EventError(f"sample(start={start}, interval={interval}): the interval "
+                                 "must be a positive finite number", 0.0)
+        self.tables = [(t, nb + t.c0, nb + t.c1) for t in hyb.tables]
+        self.cond_pre = np.zeros(0)
+        self._time_next = math.inf
+        self._time_cause = ""
+        self.recent: deque[tuple[float, str]] = deque(maxlen=self.opts.zeno_events)
+
+    # -- public -----------------------------------------------------------------------------
+    def run(self, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray, str | None]:
+        """Simulate over ``grid`` (output points); returns times, rows (observed ``obs_idx``)
+        and a solver failure message (None on success)."""
+        t = float(grid[0])
+        x, z = self._initialize(t)
+        times: list[float] = [t]
+        rows: list[np.ndarray] = [self._obs(t, x, z)]
+
+        def record() -> None:
+            times.append(t)
+            rows.append(self._obs(t, x, z))
+
+        stop = float(grid[-1])
+        k_out = 1
+        failure = None
+        while t < stop:
+            t_event, kind = self._next_time_event(t, stop)
+            j = k_out
+            while j < len(grid) and grid[j] < t_event:
+                j += 1
+            try:
+                t, x, z, crossed, passed = self._advance(t, t_event, x, z, grid[k_out:j])
+            except RuntimeError as err:
+                failure = str(err)
+                break
+            for t_k, row in passed:
+                times.append(t_k)
+                rows.append(row)
+                k_out += 1
+            if crossed is None and kind is not None:
+                crossed = kind
+            if crossed is not None:
+                record()
+                x, z = self._event(t, x, z, crossed)
+                record()
+                while k_out < len(grid) and grid[k_out] <= t:
+                    k_out += 1
+            elif t >= stop:
+                record()
+                k_out = len(grid)
+        if failure is None and self.dae.hybrid.terminal >= 0:
+            record()
+            x, z = self._event(t, x, z, "terminal")
+            record()
+        return np.array(times), np.array(rows), failure
+
+    @property
+    def meta(self) -> dict[str, Any]:
+        return {"event_times": list(self.log.times), "n_events": len(self.log.times),
+                "event_kinds": dict(_count(self.log.kinds)),
+                "event_causes": dict(self.log.causes)}
+
+    # -- continuous phase -------------------------------------------------------------------
+    def _advance(self, t0: float, t1: float, x, z, outs: np.ndarray):
+        """Integrate from t0 to t1 through the output points ``outs`` (inside (t0, t1));
+        stop at the first state event. Returns (t, x, z, cause or None, output rows)."""
+        fn = self.fn
+        if t1 <= t0:
+            return t0, x, z, None, []
+        if self.dae.x.numel() == 0:
+            if fn.state_rel:
+                raise EventError("a model without states cannot have state events yet; "
+                                 "write the switching condition on time or a state", t0)
+            passed = [(float(tk), self._obs(float(tk), x, self._solve_z(float(tk), x)))
+                      for tk in outs]
+            return t1, x, self._solve_z(t1, x), None, passed
+        if not fn.state_rel and len(outs) == 0:
+            xf, zf = self._integrate_one(t0, t1, x, z)
+            return t1, xf, zf, None, []
+        checks = self.opts.checks if fn.state_rel else 1
+        offsets = np.union1d(np.asarray(outs, dtype=float) - t0,
+                             (t1 - t0) * np.arange(1, checks + 1) / checks)
+        offsets = offsets[offsets > 0]
+        F = self._shifted(tuple(offsets))
+        out = F(x0=x, z0=z, p=np.concatenate([self.p, [t0]]))
+        self._count(F)
+        X = np.asarray(out["xf"]).reshape(len(x), -1)
+        nz = self.dae.z.numel()
+        Z = np.asarray(out["zf"]).reshape(nz, -1) if nz else np.zeros((0, X.shape[1]))
+        ts = t0 + offsets
+        ts[-1] = t1
+        out_set = set(np.asarray(outs, dtype=float).tolist())
+        last = X.shape[1]
+        crossing = None
+        if fn.state_rel:
+            m = X.shape[1]
+            G = np.asarray(self._ind_map(m)(ts.reshape(1, -1), X, Z, self.p))
+            frozen = self.p[fn.rel_slot[fn.state_rel]].astype(bool)
+            now = self._values(G, fn.strict[fn.state_rel])
+            cols = np.nonzero((now != frozen[:, None]).any(axis=0))[0]
+            if cols.size:
+                j = int(cols[0])
+                last = j
+                lo = (t0, x, z) if j == 0 else (float(ts[j - 1]), X[:, j - 1],
+                                                   Z[:, j - 1] if nz else z)
+                g_lo = self._ind(*lo) if j == 0 else G[:, j - 1]
+                crossing = self._locate(lo[0], lo[1], lo[2], g_lo, float(ts[j]), X[:, j],
+                                        Z[:, j] if nz else z, G[:, j], frozen)
+        passed = []
+        for c in range(last):
+            if float(t0 + offsets[c]) in out_set:
+                tk = float(t0 + offsets[c])
+                passed.append((tk, self._obs(tk, X[:, c], Z[:, c] if nz else z)))
+        if crossing is not None:
+            return (*crossing[:3], crossing[3], passed)
+        return t1, X[:, -1], Z[:, -1] if nz else z, None, passed
+
+    def _shifted(self, offsets: tuple[float, ...]) -> ca.Function:
+        """An integrator from t0 (a parameter) to ``t0 + offsets`` (cached)."""
+        cache = self.dae.cache.setdefault(("shifted", self._opts_key), {})
+        F = cache.get(offsets)
+        if F is None:
+            if len(cache) > 64:
+                cache.pop(next(iter(cache)))
+            F = _integrator(self.dae, self._sol_opts, list(offsets), scaled=False)
+            cache[offsets] = F
+        return F
+
+    def _locate(self, lo_t, lo_x, lo_z, g_lo, hi_t, hi_x, hi_z, g_hi, frozen):
+        """Illinois iteration on the earliest crossing indicator in [lo_t, hi_t]."""
+        fn = self.fn
+        strict = fn.strict[fn.state_rel]
+        tol = self.opts.event_tol * max(1.0, abs(hi_t))
+        g_lo = np.array(g_lo, dtype=float)
+        g_hi = np.array(g_hi, dtype=float)
+        side = 0
+        for _ in range(200):
+            if hi_t - lo_t <= tol:
+                break
+            changed = self._values(g_hi[:, None], strict)[:, 0] != frozen
+            cand = hi_t
+            for k in np.nonzero(changed)[0]:
+                a, b = g_lo[k], g_hi[k]
+                if a != b:
+                    tc = lo_t + (hi_t - lo_t) * a / (a - b)
+                    cand = min(cand, tc)
+            margin = 0.1 * tol
+            cand = min(max(cand, lo_t + margin), hi_t - margin)
+            if not (lo_t < cand < hi_t):
+                cand = 0.5 * (lo_t + hi_t)
+            xc, zc = self._integrate_one(lo_t, cand, lo_x, lo_z)
+            gc = self._ind(cand, xc, zc)
+            if (self._values(gc[:, None], strict)[:, 0] != frozen).any():
+                hi_t, hi_x, hi_z, g_hi = cand, xc, zc, gc
+                if side == 1:
+                    g_lo = g_lo * 0.5
+                side = 1
+            else:
+                lo_t, lo_x, lo_z, g_lo = cand, xc, zc, gc
+                if side == -1:
+                    g_hi = g_hi * 0.5
+                side = -1
+        changed = self._values(g_hi[:, None], strict)[:, 0] != frozen
+        cause = " and ".join(self.fn.relations[fn.state_rel[k]].text
+                             for k in np.nonzero(changed)[0][:3])
+        return hi_t, hi_x, hi_z, f"state:{cause}"
+
+    def _integrate_one(self, t0, t1, x, z):
+        if self._one is None:
+            self._one = _integrator(self.dae, self._sol_opts, [1.0], scaled=True)
+        F = self._one
+        out = F(x0=x, z0=z, p=np.concatenate([self.p, [t0, t1 - t0]]))
+        self._count(F)
+        xf = np.asarray(out["xf"]).ravel()
+        zf = np.asarray(out["zf"]).ravel() if self.dae.z.numel() else z
+        return xf, zf
+
+    def _ind(self, t, x, z) -> np.ndarray:
+        return np.asarray(self.fn.indicators(t, x, z, self.p)).ravel()
+
+    def _ind_map(self, m: int) -> ca.Function:
+        key = ("ind_map", m)
+        if key not in self.dae.cache:
+            self.dae.cache[key] = self.fn.indicators.map(m)
+        return self.dae.cache[key]
+
+    @staticmethod
+    def _values(g: np.ndarray, strict: np.ndarray) -> np.ndarray:
+        return np.where(strict[:, None], g > 0, g >= 0)
+
+    def _count(self, F: ca.Function) -> None:
+        for key in ("nsteps", "nfevals", "nlinsetups", "netfails"):
+            val = F.stats().get(key)
+            if isinstance(val, (int, float)):
+                self.stats[key] = self.stats.get(key, 0) + val
+
+    # -- time events ------------------------------------------------------------------------
+    def _next_time_event(self, t: float, stop: float) -> tuple[float, str | None]:
+        best, kind = math.inf, None
+        for start, interval, _ in self.samples:
+            ts = next_sample(start, interval, t)
+            if ts < best:
+                best, kind = ts, "sample"
+        for table, _, _ in self.tables:
+            ts = table_coefficients(table, t)[2]
+            if ts <= t:
+                ts = table_coefficients(table, math.nextafter(ts, math.inf))[2]
+            if ts < best:
+                best, kind = ts, "table"
+        if self._time_next < best:
+            best, kind = self._time_next, "time"
+        if best > stop:
+            return stop, None
+        return best, kind
+
+    def _schedule_time_relations(self, t: float, g: np.ndarray, dgdt: np.ndarray) -> None:
+        """Next instant where a relation on time alone changes value."""
+        fn = self.fn
+        self._time_next = math.inf
+        for k in fn.time_rel:
+            a = dgdt[k]
+            if a == 0.0 or not math.isfinite(a):
+                continue
+            value = bool(self.p[fn.rel_slot[k]])
+            if value == (a > 0):
+                continue
+            ts = t - g[k] / a
+            if ts > t:
+                self._time_next = min(self._time_next, ts)
+                self._time_cause = fn.relations[k].text
+
+    # -- events -----------------------------------------------------------------------------
+    def _initialize(self, t0: float):
+        fn = self.fn
+        self._time_next = math.inf
+        self._update_tables(t0)
+        x, z = self._consistent(t0, None)
+        for _ in range(self.opts.max_iterations):
+            g, dgdt, *_ = self._step(t0, x, z)
+            vals = self._relation_values(t0, g, dgdt)
+            if np.array_equal(vals, self.p[fn.rel_slot]):
+                break
+            self.p[fn.rel_slot] = vals
+            x, z = self._consistent(t0, None)
+        # conditions true at the start do not fire; initial() and samples at t0 do
+        out = self._step(t0, x, z)
+        self.cond_pre = np.asarray(out[2], dtype=float).copy()
+        self._set_pre_from(out)
+        samples = [slot for start, interval, slot in self.samples
+                   if is_sample_instant(start, interval, t0)]
+        hyb = self.dae.hybrid
+        if hyb.initial >= 0:
+            self.p[self.dae.n_base + hyb.initial] = 1.0
+        return self._iterate(t0, x, z, samples)
+
+    def _consistent(self, t: float, x, fixed: list[tuple[int, float]] | None = None):
+        """Consistent (x, z) at t: the model's initial conditions when ``x`` is None,
+        else ``x`` kept (except ``fixed`` re-initialized variables) and z solved."""
+        dae = self.dae
+        if x is None:
+            init = initialize(dae, self.p, t)
+            return init.x0, init.z0
+        if fixed:
+            d = replace(dae, x_start=np.asarray(x, dtype=float), fixed=fixed)
+            init = initialize(d, self.p, t)
+            return init.x0, init.z0
+        return x, self._solve_z(t, x)
+
+    def _solve_z(self, t: float, x) -> np.ndarray:
+        if self.fn.alg_solver is None:
+            return np.zeros(0)
+        guess = getattr(self, "_z_guess", None)
+        if guess is None or len(guess) != self.dae.z.numel():
+            guess = self.dae.z_start
+        z = np.asarray(self.fn.alg_solver(guess, np.concatenate([[t], x, self.p]))).ravel()
+        self._z_guess = z
+        return z
+
+    def _step(self, t, x, z):
+        return [np.asarray(v).ravel() for v in self.fn.step(t, x, z, self.p)]
+
+    def _relation_values(self, t: float, g: np.ndarray, dgdt: np.ndarray) -> np.ndarray:
+        """Relation values at an event instant: the sign of the indicator; for relations on
+        time alone at their crossing, the right limit (the sign of the slope)."""
+        fn = self.fn
+        vals = np.where(fn.strict, g > 0, g >= 0).astype(float)
+        for k in fn.time_rel:
+            a = dgdt[k]
+            if a != 0.0 and abs(g[k]) <= 1e-12 * abs(a) * max(1.0, abs(t)):
+                vals[k] = float(a > 0)
+        return vals
+
+    def _set_pre_from(self, out) -> None:
+        if self.fn.pre_slot.size:
+            self.p[self.fn.pre_slot] = out[5]
+
+    def _update_tables(self, t: float) -> None:
+        for table, i0, i1 in self.tables:
+            c0, c1, _ = table_coefficients(table, t)
+            self.p[i0], self.p[i1] = c0, c1
+
+    def _event(self, t: float, x, z, cause: str):
+        """Handle an event at t (state, time, sample, table or terminal)."""
+        self._note(t, cause)
+        if cause == "table" or self.tables:
+            self._update_tables(t)
+        samples = [slot for start, interval, slot in self.samples
+                   if is_sample_instant(start, interval, t)]
+        if cause == "terminal":
+            self.p[self.dae.n_base + self.dae.hybrid.terminal] = 1.0
+        # left limits of every pre() source, with the values before the event
+        self._set_pre_from(self._step(t, x, z))
+        return self._iterate(t, x, z, samples)
+
+    def _iterate(self, t: float, x, z, samples: list[int]):
+        """Event iteration to a fixed point of the discrete equations."""
+        fn = self.fn
+        dae = self.dae
+        nb = dae.n_base
+        for slot in samples:
+            self.p[slot] = 1.0
+        changing: list[str] = []
+        for _it in range(self.opts.max_iterations):
+            z = self._solve_z(t, x) if fn.alg_solver is not None else z
+            g, dgdt, cond, assign, reinit, pre_src, obs = self._step(t, x, z)
+            changing = []
+            rel = self._relation_values(t, g, dgdt)
+            moved = rel != self.p[fn.rel_slot]
+            if moved.any():
+                changing += [fn.relations[k].text for k in np.nonzero(moved)[0][:4]]
+                self.p[fn.rel_slot] = rel
+                continue
+            fired = []
+            for ids in fn.branch_of:
+                for b in ids:
+                    if cond[b] and not self.cond_pre[b]:
+                        fired.append(b)
+                        break
+            self.cond_pre = cond.astype(float).copy()
+            new_x, fixed = np.array(x, dtype=float), []
+            for b in fired:
+                for pidx, pos in fn.assign_of[b]:
+                    if self.p[pidx] != assign[pos]:
+                        changing.append(dae.discretes[pidx - nb].name)
+                    self.p[pidx] = assign[pos]
+                for name, pos in fn.reinit_of[b]:
+                    rep, sign = dae.aliases.get(name, (name, 1.0))
+                    value = sign * reinit[pos]
+                    changing.append(f"reinit({name})")
+                    if rep in dae.state_names:
+                        new_x[dae.state_names.index(rep)] = value
+                    else:
+                        fixed.append((dae.observed_index[rep], value))
+            # discrete variables defined by equations: pre() must catch up with them
+            disc_changed = fn.pre_discrete & (pre_src != self.p[fn.pre_slot]) \
+                if fn.pre_slot.size else np.zeros(0, dtype=bool)
+            for k in np.nonzero(disc_changed)[0][:4]:
+                changing.append(dae.hybrid.pre[k][1])
+            if fn.pre_slot.size:
+                self.p[fn.pre_slot] = np.where(fn.pre_discrete, pre_src, self.p[fn.pre_slot])
+            if fired and (fixed or len(new_x) and not np.array_equal(new_x, x)):
+                if fixed:
+                    fixed += [(dae.observed_index[n], float(new_x[i]))
+                              for i, n in enumerate(dae.state_names)
+                              if new_x[i] != x[i]]
+                    x, z = self._consistent(t, new_x, fixed)
+                else:
+                    x = new_x
+            if not changing:
+                break
+        else:
+            names = ", ".join(dict.fromkeys(changing))
+            raise EventError(
+                f"event iteration at t = {t:g} s did not converge after "
+                f"{self.opts.max_iterations} iterations: {names} keep changing (a discrete "
+                "equation without pre() feeding back on itself?)", t)
+        # after the instant: clocks fall, initial()/terminal() end; conditions re-armed
+        for slot in samples:
+            self.p[slot] = 0.0
+        if dae.hybrid.initial >= 0:
+            self.p[nb + dae.hybrid.initial] = 0.0
+        z = self._solve_z(t, x) if fn.alg_solver is not None else z
+        out = self._step(t, x, z)
+        self.cond_pre = np.asarray(out[2], dtype=float).copy()
+        self._set_pre_from(out)
+        self._schedule_time_relations(t, out[0], out[1])
+        return x, z
+
+    def _note(self, t: float, cause: str) -> None:
+        kind = cause.split(":", 1)[0]
+        self.log.times.append(t)
+        self.log.kinds.append(kind)
+        key = cause.split(":", 1)[1] if ":" in cause else (
+            self._time_cause if kind == "time" else kind)
+        self.log.causes[key] = self.log.causes.get(key, 0) + 1
+        self.recent.append((t, key))
+        if len(self.recent) == self.recent.maxlen:
+            span = self.recent[-1][0] - self.recent[0][0]
+            if span <= self.opts.zeno_dt * max(1.0, abs(t)):
+                worst = max(set(k for _, k in self.recent),
+                            key=lambda k: sum(1 for _, c in self.recent if c == k))
+                raise EventError(
+                    f"chattering at t = {t:.12g} s: {len(self.recent)} events within "
+                    f"{span:.3g} s, triggered by {worst}; the model switches back and forth "
+                    "without time passing (Zeno behaviour). Add hysteresis or a stuck/rest "
+                    "mode", t)
+
+    def _obs(self, t, x, z) -> np.ndarray:
+        out = np.asarray(self.fn.step(t, x, z, self.p)[6]).ravel()
+        return out[self.obs_idx]
+
+
+def _count(items: list[str]) -> dict[str, int]:
+    out: dict[str, int] = {}
+    for k in items:
+        out[k] = out.get(k, 0) + 1
+    return out
+
+
+def _integrator(dae: CasadiDAE, opts: dict, tout: list[float], scaled: bool) -> ca.Function:
+    """CVODES (ODE) or IDAS (DAE) integrator of the model from ``t0``: over ``tau`` in [0, 1]
+    with ``t = t0 + tau*dt`` when ``scaled`` (p = [p, t0, dt]), else over offsets ``tau``
+    with ``t = t0 + tau`` (p = [p, t0]). Cached in ``dae.cache`` by its settings."""
+    key = ("hybrid_integrator", scaled, tuple(tout), tuple(sorted(opts.items())))
+    if key in dae.cache:
+        return dae.cache[key]
+    t0, dt, tau = ca.SX.sym("t0"), ca.SX.sym("dt"), ca.SX.sym("tau")
+    t_of = t0 + tau * dt if scaled else t0 + tau
+    scale = dt if scaled else 1
+    x, ode = dae.x, dae.ode
+    problem = {"x": x, "p": ca.vertcat(dae.p, t0, dt) if scaled else ca.vertcat(dae.p, t0),
+               "t": tau, "ode": scale * ca.substitute(ode, dae.t, t_of)}
+    solver = "cvodes"
+    solver_opts = dict(opts)
+    if dae.z.numel():
+        problem.update(z=dae.z, alg=ca.substitute(dae.alg, dae.t, t_of))
+        solver = "idas"
+        solver_opts["calc_ic"] = True
+    F = ca.integrator("segment", solver, problem, 0.0, [float(v) for v in tout], solver_opts)
+    if scaled:
+        dae.cache[key] = F
+    return F
