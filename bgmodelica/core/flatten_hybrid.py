@@ -202,6 +202,7 @@ def lower(draft: HybridDraft, slot_of: Callable[[Symbol], int],
     or discrete symbol's index in the model's discrete vector, ``name_of`` a variable's
     dotted name)."""
     part = HybridPart()
+    slot_sx = {slot_of(sym): sym.sx for sym in draft.targets.values()}
     for r in draft.relations:
         a, b = to_sx(r.a), to_sx(r.b)
         ind = ca.SX(b - a)
@@ -217,6 +218,7 @@ def lower(draft: HybridDraft, slot_of: Callable[[Symbol], int],
                     reinits.append((name_of(s.target), to_sx(s.value)))
                 else:
                     assigns.append((slot_of(s.lhs.sym), to_sx(s.rhs)))
+            assigns, reinits = _simultaneous(assigns, reinits, here, slot_sx)
             branches.append(FlatBranch(to_sx(cond), to_text(cond), assigns, reinits))
         part.whens.append(FlatWhen(branches, here))
     part.pre = [(slot_of(p), name_of(p.pre_of)) for p in draft.pres.values()]
@@ -231,6 +233,30 @@ def lower(draft: HybridDraft, slot_of: Callable[[Symbol], int],
         elif s is _TERMINAL:
             part.terminal = slot_of(s)
     return part
+
+
+def _simultaneous(assigns: list[tuple[int, ca.SX]], reinits: list[tuple[str, ca.SX]],
+                  here: str, slot_sx: dict[int, ca.SX]) -> tuple[list, list]:
+    """Make a when-body's assignments simultaneous equations, as in Modelica: a right side
+    that reads a variable assigned in the same body sees its new value."""
+    if not assigns:
+        return assigns, reinits
+    targets = [t for t, _ in assigns]
+    syms = ca.vertcat(*[slot_sx[t] for t in targets])
+    values = [v for _, v in assigns]
+    for _ in range(len(values) + 1):
+        pending = [k for k, v in enumerate(values) if ca.depends_on(v, syms)]
+        if not pending:
+            break
+        values = list(ca.substitute(values, [syms], [ca.vertcat(*values)]))
+    else:
+        raise EquationError(f"{here}: the assignments of a when-clause depend on each other in a "
+                            "cycle; use pre() for the previous values")
+    rvals = [v for _, v in reinits]
+    if rvals:
+        rvals = list(ca.substitute(rvals, [syms], [ca.vertcat(*values)]))
+    return (list(zip(targets, values, strict=True)),
+            [(n, v) for (n, _), v in zip(reinits, rvals, strict=True)])
 
 
 def _time_only(e: Any) -> bool:

@@ -26,6 +26,7 @@ import numpy as np
 from ..backends.casadi_dae import CasadiDAE
 from ..backends.casadi_init import initialize
 from ..errors import SimulationError
+from .fast import Fast
 from .functions import HybridFunctions, build
 from .schedule import is_sample_instant, next_sample, table_coefficients
 
@@ -70,6 +71,9 @@ class HybridSimulator:
         sol_opts: dict[str, Any] = {"abstol": atol, "reltol": rtol, "max_num_steps": max_steps}
         if max_step is not None:
             sol_opts["max_step_size"] = float(max_step)
+        self._step_fast = Fast(self.fn.step)
+        self._ind_fast = Fast(self.fn.indicators)
+        self.n_segments = 0
         self._sol_opts = sol_opts
         self._opts_key = tuple(sorted(sol_opts.items()))
         self._one: ca.Function | None = None
@@ -125,23 +129,24 @@ class HybridSimulator:
             if crossed is None and kind is not None:
                 crossed = kind
             if crossed is not None:
-                record()
-                x, z = self._event(t, x, z, crossed)
-                record()
+                x, z, left, right = self._event(t, x, z, crossed)
+                times += [t, t]
+                rows += [left, right]
                 while k_out < len(grid) and grid[k_out] <= t:
                     k_out += 1
             elif t >= stop:
                 record()
                 k_out = len(grid)
         if failure is None and self.dae.hybrid.terminal >= 0:
-            record()
-            x, z = self._event(t, x, z, "terminal")
-            record()
+            x, z, left, right = self._event(t, x, z, "terminal")
+            times += [t, t]
+            rows += [left, right]
         return np.array(times), np.array(rows), failure
 
     @property
     def meta(self) -> dict[str, Any]:
         return {"event_times": list(self.log.times), "n_events": len(self.log.times),
+                "integrator_calls": self.n_segments,
                 "event_kinds": dict(_count(self.log.kinds)),
                 "event_causes": dict(self.log.causes)}
 
@@ -167,11 +172,12 @@ class HybridSimulator:
                              (t1 - t0) * np.arange(1, checks + 1) / checks)
         offsets = offsets[offsets > 0]
         F = self._shifted(tuple(offsets))
-        out = F(x0=x, z0=z, p=np.concatenate([self.p, [t0]]))
-        self._count(F)
-        X = np.asarray(out["xf"]).reshape(len(x), -1)
+        res = F(x, z, np.concatenate([self.p, [t0]]))
+        self.n_segments += 1
+        n_t = len(offsets)
+        X = res[0].reshape(n_t, len(x)).T.copy()
         nz = self.dae.z.numel()
-        Z = np.asarray(out["zf"]).reshape(nz, -1) if nz else np.zeros((0, X.shape[1]))
+        Z = res[1].reshape(n_t, nz).T.copy() if nz else np.zeros((0, n_t))
         ts = t0 + offsets
         ts[-1] = t1
         out_set = set(np.asarray(outs, dtype=float).tolist())
@@ -200,14 +206,14 @@ class HybridSimulator:
             return (*crossing[:3], crossing[3], passed)
         return t1, X[:, -1], Z[:, -1] if nz else z, None, passed
 
-    def _shifted(self, offsets: tuple[float, ...]) -> ca.Function:
+    def _shifted(self, offsets: tuple[float, ...]) -> Fast:
         """An integrator from t0 (a parameter) to ``t0 + offsets`` (cached)."""
         cache = self.dae.cache.setdefault(("shifted", self._opts_key), {})
         F = cache.get(offsets)
         if F is None:
             if len(cache) > 64:
                 cache.pop(next(iter(cache)))
-            F = _integrator(self.dae, self._sol_opts, list(offsets), scaled=False)
+            F = Fast(_integrator(self.dae, self._sol_opts, list(offsets), scaled=False))
             cache[offsets] = F
         return F
 
@@ -252,16 +258,17 @@ class HybridSimulator:
 
     def _integrate_one(self, t0, t1, x, z):
         if self._one is None:
-            self._one = _integrator(self.dae, self._sol_opts, [1.0], scaled=True)
-        F = self._one
-        out = F(x0=x, z0=z, p=np.concatenate([self.p, [t0, t1 - t0]]))
-        self._count(F)
-        xf = np.asarray(out["xf"]).ravel()
-        zf = np.asarray(out["zf"]).ravel() if self.dae.z.numel() else z
-        return xf, zf
+            self._one = Fast(_integrator(self.dae, self._sol_opts, [1.0], scaled=True))
+            self._pe = np.zeros(len(self.p) + 2)
+        pe = self._pe
+        pe[:-2] = self.p
+        pe[-2], pe[-1] = t0, t1 - t0
+        res = self._one(x, z, pe)
+        self.n_segments += 1
+        return res[0].copy(), (res[1].copy() if self.dae.z.numel() else z)
 
     def _ind(self, t, x, z) -> np.ndarray:
-        return np.asarray(self.fn.indicators(t, x, z, self.p)).ravel()
+        return self._ind_fast(t, x, z, self.p)[0].copy()
 
     def _ind_map(self, m: int) -> ca.Function:
         key = ("ind_map", m)
@@ -272,12 +279,6 @@ class HybridSimulator:
     @staticmethod
     def _values(g: np.ndarray, strict: np.ndarray) -> np.ndarray:
         return np.where(strict[:, None], g > 0, g >= 0)
-
-    def _count(self, F: ca.Function) -> None:
-        for key in ("nsteps", "nfevals", "nlinsetups", "netfails"):
-            val = F.stats().get(key)
-            if isinstance(val, (int, float)):
-                self.stats[key] = self.stats.get(key, 0) + val
 
     # -- time events ------------------------------------------------------------------------
     def _next_time_event(self, t: float, stop: float) -> tuple[float, str | None]:
@@ -336,7 +337,8 @@ class HybridSimulator:
         hyb = self.dae.hybrid
         if hyb.initial >= 0:
             self.p[self.dae.n_base + hyb.initial] = 1.0
-        return self._iterate(t0, x, z, samples)
+        x, z, _ = self._iterate(t0, x, z, samples)
+        return x, z
 
     def _consistent(self, t: float, x, fixed: list[tuple[int, float]] | None = None):
         """Consistent (x, z) at t: the model's initial conditions when ``x`` is None,
@@ -361,8 +363,9 @@ class HybridSimulator:
         self._z_guess = z
         return z
 
-    def _step(self, t, x, z):
-        return [np.asarray(v).ravel() for v in self.fn.step(t, x, z, self.p)]
+    def _step(self, t, x, z) -> list[np.ndarray]:
+        """g, dgdt, cond, assign, reinit, pre, obs at (t, x, z) (copies)."""
+        return [r.copy() for r in self._step_fast(t, x, z, self.p)]
 
     def _relation_values(self, t: float, g: np.ndarray, dgdt: np.ndarray) -> np.ndarray:
         """Relation values at an event instant: the sign of the indicator; for relations on
@@ -385,29 +388,36 @@ class HybridSimulator:
             self.p[i0], self.p[i1] = c0, c1
 
     def _event(self, t: float, x, z, cause: str):
-        """Handle an event at t (state, time, sample, table or terminal)."""
+        """Handle an event at t (state, time, sample, table or terminal); returns the new
+        (x, z) and the left- and right-limit rows."""
         self._note(t, cause)
-        if cause == "table" or self.tables:
+        out = self._step(t, x, z)
+        left = out[6][self.obs_idx]
+        self._set_pre_from(out)            # left limits of every pre() source
+        if self.tables:
             self._update_tables(t)
         samples = [slot for start, interval, slot in self.samples
                    if is_sample_instant(start, interval, t)]
         if cause == "terminal":
             self.p[self.dae.n_base + self.dae.hybrid.terminal] = 1.0
-        # left limits of every pre() source, with the values before the event
-        self._set_pre_from(self._step(t, x, z))
-        return self._iterate(t, x, z, samples)
+        x, z, out = self._iterate(t, x, z, samples)
+        return x, z, left, out[6][self.obs_idx]
 
     def _iterate(self, t: float, x, z, samples: list[int]):
-        """Event iteration to a fixed point of the discrete equations."""
+        """Event iteration to a fixed point of the discrete equations; returns (x, z) and the
+        step outputs at the converged point."""
         fn = self.fn
         dae = self.dae
         nb = dae.n_base
         for slot in samples:
             self.p[slot] = 1.0
+        flags = bool(samples) or dae.hybrid.initial >= 0 and self.p[nb + dae.hybrid.initial]
         changing: list[str] = []
-        for _it in range(self.opts.max_iterations):
-            z = self._solve_z(t, x) if fn.alg_solver is not None else z
-            g, dgdt, cond, assign, reinit, pre_src, obs = self._step(t, x, z)
+        for _ in range(self.opts.max_iterations):
+            if fn.alg_solver is not None:
+                z = self._solve_z(t, x)
+            out = self._step(t, x, z)
+            g, dgdt, cond, assign, reinit, pre_src, _ = out
             changing = []
             rel = self._relation_values(t, g, dgdt)
             moved = rel != self.p[fn.rel_slot]
@@ -421,7 +431,7 @@ class HybridSimulator:
                     if cond[b] and not self.cond_pre[b]:
                         fired.append(b)
                         break
-            self.cond_pre = cond.astype(float).copy()
+            self.cond_pre = cond
             new_x, fixed = np.array(x, dtype=float), []
             for b in fired:
                 for pidx, pos in fn.assign_of[b]:
@@ -436,21 +446,17 @@ class HybridSimulator:
                         new_x[dae.state_names.index(rep)] = value
                     else:
                         fixed.append((dae.observed_index[rep], value))
-            # discrete variables defined by equations: pre() must catch up with them
-            disc_changed = fn.pre_discrete & (pre_src != self.p[fn.pre_slot]) \
-                if fn.pre_slot.size else np.zeros(0, dtype=bool)
-            for k in np.nonzero(disc_changed)[0][:4]:
-                changing.append(dae.hybrid.pre[k][1])
             if fn.pre_slot.size:
+                # discrete variables defined by equations: pre() must catch up with them
+                lag = fn.pre_discrete & (pre_src != self.p[fn.pre_slot])
+                changing += [dae.hybrid.pre[k][1] for k in np.nonzero(lag)[0][:4]]
                 self.p[fn.pre_slot] = np.where(fn.pre_discrete, pre_src, self.p[fn.pre_slot])
-            if fired and (fixed or len(new_x) and not np.array_equal(new_x, x)):
-                if fixed:
-                    fixed += [(dae.observed_index[n], float(new_x[i]))
-                              for i, n in enumerate(dae.state_names)
-                              if new_x[i] != x[i]]
-                    x, z = self._consistent(t, new_x, fixed)
-                else:
-                    x = new_x
+            if fixed:
+                fixed += [(dae.observed_index[n], float(new_x[i]))
+                          for i, n in enumerate(dae.state_names) if new_x[i] != x[i]]
+                x, z = self._consistent(t, new_x, fixed)
+            elif fired:
+                x = new_x
             if not changing:
                 break
         else:
@@ -459,17 +465,17 @@ class HybridSimulator:
                 f"event iteration at t = {t:g} s did not converge after "
                 f"{self.opts.max_iterations} iterations: {names} keep changing (a discrete "
                 "equation without pre() feeding back on itself?)", t)
-        # after the instant: clocks fall, initial()/terminal() end; conditions re-armed
-        for slot in samples:
-            self.p[slot] = 0.0
-        if dae.hybrid.initial >= 0:
-            self.p[nb + dae.hybrid.initial] = 0.0
-        z = self._solve_z(t, x) if fn.alg_solver is not None else z
-        out = self._step(t, x, z)
-        self.cond_pre = np.asarray(out[2], dtype=float).copy()
-        self._set_pre_from(out)
+        if flags:
+            # after the instant: clocks fall and initial() ends; conditions are re-armed
+            for slot in samples:
+                self.p[slot] = 0.0
+            if dae.hybrid.initial >= 0:
+                self.p[nb + dae.hybrid.initial] = 0.0
+            out = self._step(t, x, z)
+            self.cond_pre = out[2]
+            self._set_pre_from(out)
         self._schedule_time_relations(t, out[0], out[1])
-        return x, z
+        return x, z, out
 
     def _note(self, t: float, cause: str) -> None:
         kind = cause.split(":", 1)[0]
@@ -491,8 +497,7 @@ class HybridSimulator:
                     "mode", t)
 
     def _obs(self, t, x, z) -> np.ndarray:
-        out = np.asarray(self.fn.step(t, x, z, self.p)[6]).ravel()
-        return out[self.obs_idx]
+        return self._step_fast(t, x, z, self.p)[6][self.obs_idx]
 
 
 def _count(items: list[str]) -> dict[str, int]:
