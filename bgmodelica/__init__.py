@@ -13,6 +13,8 @@ from .core.expressions import (
     der,
     exp,
     fabs,
+    fmax,
+    fmin,
     if_else,
     log,
     sign,
@@ -60,9 +62,9 @@ __all__ = [
     "Component", "Connection", "Connector", "connect", "der", "time", "flatten",
     "Parameter", "Variable", "Potential", "Flow", "Input", "Output", "StateSelect",
     "sin", "cos", "tan", "exp", "log", "sqrt", "atan2", "fabs", "tanh", "sign", "if_else",
-    "Discrete", "Integer", "Boolean", "when", "reinit", "pre", "edge", "change", "initial",
-    "terminal", "sample", "no_event", "noEvent", "eq", "and_", "or_", "not_", "if_equation",
-    "time_table",
+    "fmin", "fmax", "Discrete", "Integer", "Boolean", "when", "reinit", "pre", "edge",
+    "change", "initial", "terminal", "sample", "no_event", "noEvent", "eq", "and_", "or_",
+    "not_", "if_equation", "time_table",
 ]
 
 from .compiler import CompiledModel, compile  # noqa: E402

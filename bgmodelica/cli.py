@@ -55,13 +55,15 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     show = args.progress if args.progress is not None else sys.stderr.isatty()
     result = simulate(compiled, stop_time=args.stop_time, interval=args.interval,
                       params=params, rtol=args.rtol, atol=args.atol,
-                      progress=_progress if show else None)
+                      progress=_progress if show else None, inputs=args.input)
     out = Path(args.output) if args.output else Path(f"{compiled.name}.csv")
     result.to_csv(out)
     print(f"{compiled.name}: {len(result.time)} points, compile {compiled.compile_time:.3f} s, "
           f"run {result.meta['run_seconds']:.3f} s -> {out}")
     for note in result.meta.get("init_notes", []):
         print(f"note: {note}")
+    if result.meta.get("n_events"):
+        print(f"events: {result.meta['n_events']} (two rows, left and right limit, at each)")
     if args.plot:
         names = args.plot_vars or result.meta["states"][:6] or result.names[:6]
         result.plot(names, args.plot, title=compiled.name)
@@ -99,6 +101,23 @@ def cmd_check(args: argparse.Namespace) -> int:
     print(f"  algebraic loops: {len(loops)}"
           + "".join(f"\n    size {lp['size']} ({lp['kind']}), tearing: "
                     f"{', '.join(lp['tearing']) or '-'}" for lp in loops))
+    ev = summary.get("events")
+    if ev:
+        print(f"  discrete variables ({len(ev['discrete_variables'])}): "
+              + (", ".join(f"{d['name']} ({d['type']})" for d in ev["discrete_variables"])
+                 or "-"))
+        print(f"  event conditions ({len(ev['conditions'])}):"
+              + "".join(f"\n    {c['relation']}  [{c['kind']}, {c['in']}]"
+                        for c in ev["conditions"]))
+        print(f"  when-clauses: {len(ev['when_clauses'])}"
+              + "".join(f"\n    when {b['condition']}: "
+                        + ", ".join(b["assigns"] + [f"reinit({r})" for r in b["reinits"]])
+                        for w in ev["when_clauses"] for b in w["branches"]))
+        if ev["clocks"]:
+            print("  clocks: " + ", ".join(f"sample({c['start']:g}, {c['interval']:g})"
+                                           for c in ev["clocks"]))
+        if ev["tables"]:
+            print(f"  time tables: {len(ev['tables'])}")
     if summary["dynamic_state_selection"]:
         print("  state selection may change during simulation (dynamic state selection)")
     if summary["inputs"]:
@@ -163,6 +182,9 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--interval", type=float, default=None, help="output step [s]")
     sim.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                      help="override a parameter / input / start value by dotted name")
+    sim.add_argument("--input", metavar="FILE.csv",
+                     help="time-varying values of the model's inputs: first column 'time', "
+                          "one column per input (linear; a repeated time is a jump)")
     sim.add_argument("-o", "--output", help="CSV file (default <Model>.csv)")
     sim.add_argument("--plot", help="PNG file with the states (or --plot-vars)")
     sim.add_argument("--plot-vars", nargs="+", help="variables to plot")

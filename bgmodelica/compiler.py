@@ -69,7 +69,46 @@ class CompiledModel:
             "dynamic_state_selection": self.needs_dynamic_selection(),
             "parameters": len(self.dae.parameters),
             "inputs": [u.name for u in self.dae.inputs],
+            "events": self.event_summary(),
             "compile_seconds": dict(self.timings),
+        }
+
+    def event_summary(self) -> dict[str, Any] | None:
+        """Discrete variables, event conditions (state or time events), when-clauses, clocks
+        and tables of a hybrid model; None for a smooth model."""
+        hyb = self.dae.hybrid
+        if hyb is None:
+            return None
+        from .events.functions import build
+
+        fn = build(self.dae)
+        kind = {k: "time event" for k in fn.time_rel} | {k: "state event"
+                                                          for k in fn.state_rel}
+        shown = [d for d in self.dae.discretes if not d.name.startswith(("$", "pre(", "initial()",
+                                                                        "terminal()"))]
+        discrete = [{"name": d.name, "type": getattr(d.decl, "type_name", "Real"),
+                     "assigned": "when"} for d in shown]
+        discrete += [{"name": n, "type": "Real", "assigned": "equation"}
+                     for n in sorted(self.dae.discrete_names) if n not in {d.name for d in shown}]
+        import casadi as ca
+
+        clock_f = ca.Function("clocks", [self.dae.p], [ca.vertcat(
+            *[ca.vertcat(c.start, c.interval) for c in hyb.samples])] if hyb.samples
+            else [ca.SX(0, 1)])
+        vals = [float(v) for v in ca.DM(clock_f(self.dae.p_default)).full().ravel()]
+        return {
+            "discrete_variables": discrete,
+            "conditions": [{"relation": r.text, "kind": kind[k], "in": r.origin}
+                           for k, r in enumerate(hyb.relations)],
+            "when_clauses": [{"in": w.origin, "branches": [
+                {"condition": b.text,
+                 "assigns": [self.dae.discretes[s].name for s, _ in b.assignments],
+                 "reinits": [n for n, _ in b.reinits]} for b in w.branches]}
+                for w in hyb.whens],
+            "clocks": [{"start": vals[2 * k], "interval": vals[2 * k + 1]}
+                       for k in range(len(hyb.samples))],
+            "tables": [{"breakpoints": len(t.times), "interpolation": t.interpolation,
+                        "extrapolation": t.extrapolation} for t in hyb.tables],
         }
 
 

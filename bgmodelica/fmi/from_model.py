@@ -21,7 +21,7 @@ from ..compiler import CompiledModel, compile
 from ..core.component import Component
 from ..core.variables import KIND_OUTPUT
 from .export import export_fmu
-from .spec import FmuSpec, ScalarVariable
+from .spec import FmuSpec, FmuSpecError, ScalarVariable
 
 
 def fmu_spec(model: Component | CompiledModel, *, stop_time: float = 1.0,
@@ -30,6 +30,17 @@ def fmu_spec(model: Component | CompiledModel, *, stop_time: float = 1.0,
     """Describe a model for export (see the module docstring for the conventions)."""
     compiled = model if isinstance(model, CompiledModel) else compile(model)
     dae = compiled.dae
+    if dae.hybrid is not None:
+        ev = compiled.event_summary() or {}
+        what = [c["relation"] for c in ev.get("conditions", [])[:3]]
+        what += ["when-clauses"] * bool(ev.get("when_clauses"))
+        what += ["sample clocks"] * bool(ev.get("clocks"))
+        what += ["time tables"] * bool(ev.get("tables"))
+        raise FmuSpecError(
+            f"cannot export {compiled.name} as an FMU yet: it has events ("
+            + ", ".join(what) + "); the FMU runtime does not handle events, so the FMU "
+            "would be wrong. Simulate it natively, or wrap relations that need no event in "
+            "no_event()")
     flat = compiled.reduced.model
     n_par = len(dae.parameters)
     p_all = dae.p_default

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import casadi as ca
 
-from ..errors import UnbalancedModelError
+from ..errors import EquationError, UnbalancedModelError
 from ..structure import block_lower_triangular, maximum_matching, tear
 from .index_reduction import ReducedModel
 from .symbolic import solve_linear_block, solve_linear_scalar, solve_scalar_blocks
@@ -93,6 +93,7 @@ def sort_equations(reduced: ReducedModel) -> SortedDAE:
     var_hashes: set[int] = set()
     for block in blocks:
         eqs, cols = list(block.eqs), list(block.vars)
+        _check_discrete_loop(model, eqs, [unknowns[c] for c in cols], res)
         if len(eqs) == 1:
             expr = explicit[id(block)]
             if expr is not None:
@@ -109,6 +110,27 @@ def sort_equations(reduced: ReducedModel) -> SortedDAE:
         names = [variables[unknowns[c]].name for c in cols]
         _loop(out, eqs, cols, eq_cols, res, sym, unknowns, names, variables, var_hashes)
     return out
+
+
+def _check_discrete_loop(model, eqs: list[int], var_idx: list[int], res: list) -> None:
+    """A discrete variable may not be determined through a loop of equations (Modelica's
+    single-assignment rule for discrete-time equations): such a loop has no ordering; it
+    needs pre() on one of the variables to become an event iteration."""
+    variables = model.variables
+    discrete = [j for j in var_idx if variables[j].decl.kind == "discrete"]
+    if not discrete:
+        return
+    if len(eqs) == 1:
+        var = variables[var_idx[0]].sx
+        r = res[eqs[0]]
+        if not ca.depends_on(r - ca.jacobian(r, var) * var, var):
+            return
+    names = ", ".join(variables[j].origin for j in var_idx[:8])
+    eq_text = "; ".join(model.describe(e) for e in eqs[:4])
+    raise EquationError(
+        f"algebraic loop through the discrete variable(s) {names}: {eq_text}. Discrete "
+        "equations must not depend on themselves; use pre() of one of them to read the value "
+        "before the event")
 
 
 def _loop(out: SortedDAE, eqs, cols, eq_cols, res, sym, unknowns, names, variables,

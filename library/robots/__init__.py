@@ -9,8 +9,9 @@ Modules:
 - :mod:`.arm`: :class:`~.arm.TwoLinkArm` in multibody form (:mod:`library.planar`) and
   :class:`~.arm.ArmWithTorques` (joint torques as model inputs);
 - :mod:`.robot`: :class:`~.robot.RobotPID` (Fig. 13-15), :class:`~.robot.RobotComputedTorque`
-  (Fig. 12) and :func:`~.robot.arm_dynamics_functions` (M, C, G extracted from the compiled
-  multibody arm);
+  (Fig. 12), :class:`~.robot.RobotOpenLoop` (the plant: motor voltages in, joint angles out)
+  and :func:`~.robot.arm_dynamics_functions` (M, C, G extracted from the compiled multibody
+  arm);
 - :mod:`.baseline`: the hand-written robot ODE used by tests and benchmarks;
 - :mod:`.main_job`: ``run(outdir)``: the 10 s PID simulation, CSV, figures, summary.
 
@@ -24,3 +25,26 @@ leaves a choice at the dummy-derivative levels, so the simulator's *dynamic* sta
 would check it at every output point; for this open chain the joint coordinates are valid
 everywhere, so the robot simulations here pass ``dynamic=False``.
 """
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+#: The models, importable as ``library.robots:RobotPID`` etc. (loaded on first use, so that
+#: ``library.robots.lagrange`` stays importable without CasADi or the component library).
+_EXPORTS = {"RobotPID": ".robot", "RobotOpenLoop": ".robot", "RobotComputedTorque": ".robot",
+            "RobotDigitalPID": ".digital", "DigitalJointPID": ".digital",
+            "TwoLinkArm": ".arm", "ArmWithTorques": ".arm", "DCMotor": ".motor"}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str) -> Any:
+    if name in _EXPORTS:
+        return getattr(importlib.import_module(_EXPORTS[name], __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_EXPORTS))

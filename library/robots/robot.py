@@ -6,6 +6,9 @@
   feedforward on the desired trajectory, ``M(q*) q*'' + C(q*, q*') q*' + G(q*)``, plus PD
   feedback; M, C and G are *extracted from the compiled multibody arm* (see
   :func:`arm_dynamics_functions`), not typed in.
+- :class:`RobotOpenLoop`: the same arm and motors as :class:`RobotPID` without controller or
+  references; the motor voltages ``U1``, ``U2`` are model inputs, the joint angles ``q1``,
+  ``q2`` model outputs (the plant of the PID loop, e.g. for an FMU or identification).
 
 Parameters at the top level follow the paper: m1, m2, l1, l2, lc1, lc2, I1, I2, g (arm),
 motor1.* / motor2.* (R, L, k1, Jm, b, k2), Kp1, Ki1, Kd1, Kp2, Ki2, Kd2 (PID), A1, f1, A2, f2
@@ -22,6 +25,7 @@ import casadi as ca
 
 from bgmodelica import (
     Component,
+    Input,
     Output,
     Parameter,
     Variable,
@@ -38,7 +42,8 @@ from .arm import ARM_PARAMETERS, ArmWithTorques, TwoLinkArm, _ArmParameters, bon
 from .motor import DCMotor
 from .params import PID, REFERENCE, VMAX
 
-__all__ = ["RobotPID", "RobotComputedTorque", "SineReference", "arm_dynamics_functions"]
+__all__ = ["RobotPID", "RobotOpenLoop", "RobotComputedTorque", "SineReference",
+           "arm_dynamics_functions"]
 
 _TWO_PI = 2 * math.pi
 
@@ -64,21 +69,15 @@ class SineReference(Component):
         yield self.qdd == -self.A * om * om * sin(arg)
 
 
-class _RobotBase(_ArmParameters):
-    """Arm parameters at the top level, the arm, the two references.
+class _RobotArm(_ArmParameters):
+    """Arm parameters at the top level and the arm.
 
     ``arm="multibody"`` (default): :class:`~library.robots.arm.TwoLinkArm` built from
     :mod:`library.planar`; ``arm="bondgraph"``: the paper's bond graph
     (:func:`~library.robots.arm.bond_graph_arm`). Start values ``q1``, ``q2``, ``w1``, ``w2``
     go to the arm; dotted modifiers (``**{"motor1.R": 2}``) reach the subcomponents.
+    Subclasses add their parts in :meth:`_build`.
     """
-
-    A1 = Parameter(REFERENCE["A1"], unit="rad", description="Reference amplitude, joint 1")
-    f1 = Parameter(REFERENCE["f1"], unit="Hz", description="Reference frequency, joint 1")
-    A2 = Parameter(REFERENCE["A2"], unit="rad", description="Reference amplitude, joint 2")
-    f2 = Parameter(REFERENCE["f2"], unit="Hz", description="Reference frequency, joint 2")
-    e1 = Variable(unit="rad", description="Tracking error q1* - q1")
-    e2 = Variable(unit="rad", description="Tracking error q2* - q2")
 
     def __init__(self, arm: str = "multibody", **modifiers):
         if arm not in ("multibody", "bondgraph"):
@@ -90,13 +89,30 @@ class _RobotBase(_ArmParameters):
         super().__init__(**modifiers)
         make_arm = TwoLinkArm if arm == "multibody" else bond_graph_arm
         self.arm = make_arm(**{n: getattr(self, n) for n in ARM_PARAMETERS}, **starts)
-        self.ref1 = SineReference(A=self.A1, f=self.f1)
-        self.ref2 = SineReference(A=self.A2, f=self.f2)
         self._build()
         if nested:
             self.modify(**nested)
 
     def _build(self) -> None:
+        """Add the drive (and controller) subcomponents."""
+
+
+class _RobotBase(_RobotArm):
+    """:class:`_RobotArm` plus the two joint references ref1, ref2 and the tracking errors."""
+
+    A1 = Parameter(REFERENCE["A1"], unit="rad", description="Reference amplitude, joint 1")
+    f1 = Parameter(REFERENCE["f1"], unit="Hz", description="Reference frequency, joint 1")
+    A2 = Parameter(REFERENCE["A2"], unit="rad", description="Reference amplitude, joint 2")
+    f2 = Parameter(REFERENCE["f2"], unit="Hz", description="Reference frequency, joint 2")
+    e1 = Variable(unit="rad", description="Tracking error q1* - q1")
+    e2 = Variable(unit="rad", description="Tracking error q2* - q2")
+
+    def _build(self) -> None:
+        self.ref1 = SineReference(A=self.A1, f=self.f1)
+        self.ref2 = SineReference(A=self.A2, f=self.f2)
+        self._build_control()
+
+    def _build_control(self) -> None:
         """Add the drive and controller subcomponents."""
 
     def equations(self):
@@ -135,7 +151,7 @@ class RobotPID(_RobotBase):
             modifiers.setdefault("Vmax", 1e6)
         super().__init__(**modifiers)
 
-    def _build(self) -> None:
+    def _build_control(self) -> None:
         self.motor1 = DCMotor()
         self.motor2 = DCMotor()
         self.sensor1 = AngleSensor()
@@ -154,6 +170,39 @@ class RobotPID(_RobotBase):
             yield connect(pid.y, motor.u)
             yield connect(motor.flange, flange)
             yield connect(sensor.flange, flange)
+
+
+class RobotOpenLoop(_RobotArm):
+    """The PID robot's plant: the same arm and geared DC motors as :class:`RobotPID`, without
+    controller or references. The motor voltages are the top-level inputs ``U1``, ``U2`` [V]
+    (held constant over a simulation; ``--set U1=2``); the joint angles the top-level outputs
+    ``q1``, ``q2`` [rad] (= arm.q1, arm.q2).
+
+    Parameters (top level): m1, m2, l1, l2, lc1, lc2, I1, I2, g; motor1.*, motor2.*: R, L, k1,
+    Jm, b, k2. Subcomponents: arm, motor1, motor2. Variables of interest (named as in
+    :class:`RobotPID`): arm.q1, arm.q2, arm.w1, arm.w2, motor1.i, motor2.i, motor1.u,
+    motor2.u. Starts at rest at q = (0, 0) with zero currents; other start angles with
+    ``RobotOpenLoop(q1=0.3)`` or ``simulate(..., params={"arm.q1": 0.3})``.
+    States: arm.joint1.q/w, arm.joint2.q/w, motor currents. ``arm="bondgraph"`` uses the
+    paper's bond-graph arm.
+    """
+
+    U1 = Input(unit="V", description="Motor 1 armature voltage")
+    U2 = Input(unit="V", description="Motor 2 armature voltage")
+    q1 = Output(unit="rad", description="Joint 1 angle (link 1 from the x axis)")
+    q2 = Output(unit="rad", description="Joint 2 angle (link 2 relative to link 1)")
+
+    def _build(self) -> None:
+        self.motor1 = DCMotor()
+        self.motor2 = DCMotor()
+
+    def equations(self):
+        yield connect(self.U1, self.motor1.u)
+        yield connect(self.U2, self.motor2.u)
+        yield connect(self.motor1.flange, self.arm.flange1)
+        yield connect(self.motor2.flange, self.arm.flange2)
+        yield self.q1 == self.arm.q1
+        yield self.q2 == self.arm.q2
 
 
 # -- computed torque -------------------------------------------------------------------------
@@ -236,7 +285,7 @@ class RobotComputedTorque(_RobotBase):
         object.__setattr__(self, "mode", mode)
         super().__init__(**modifiers)
 
-    def _build(self) -> None:
+    def _build_control(self) -> None:
         self.model = _ModelParameters(**{n: getattr(self, n) for n in ARM_PARAMETERS})
         self.torque1 = Torque()
         self.torque2 = Torque()
