@@ -120,17 +120,36 @@ def _check_discrete_loop(model, eqs: list[int], var_idx: list[int], res: list) -
     discrete = [j for j in var_idx if variables[j].decl.kind == "discrete"]
     if not discrete:
         return
-    if len(eqs) == 1:
-        var = variables[var_idx[0]].sx
-        r = res[eqs[0]]
-        if not ca.depends_on(r - ca.jacobian(r, var) * var, var):
-            return
+    if len(eqs) == 1 and not _switches_on(res[eqs[0]], variables[var_idx[0]].sx):
+        return
     names = ", ".join(variables[j].origin for j in var_idx[:8])
     eq_text = "; ".join(model.describe(e) for e in eqs[:4])
     raise EquationError(
         f"algebraic loop through the discrete variable(s) {names}: {eq_text}. Discrete "
         "equations must not depend on themselves; use pre() of one of them to read the value "
         "before the event")
+
+
+_SWITCHING_OPS = tuple(getattr(ca, n) for n in (
+    "OP_NOT", "OP_AND", "OP_OR", "OP_EQ", "OP_NE", "OP_LT", "OP_LE", "OP_IF_ELSE_ZERO",
+    "OP_FLOOR", "OP_CEIL", "OP_SIGN") if hasattr(ca, n))
+
+
+def _switches_on(e: ca.SX, var: ca.SX) -> bool:
+    """Whether ``e`` reads ``var`` through a logical or piecewise-constant operation (a
+    dependence that solving for ``var`` cannot remove)."""
+    seen: set[int] = set()
+    stack = [e]
+    while stack:
+        node = stack.pop()
+        h = node.element_hash()
+        if h in seen or node.is_leaf():
+            continue
+        seen.add(h)
+        if any(node.is_op(op) for op in _SWITCHING_OPS) and ca.depends_on(node, var):
+            return True
+        stack.extend(node.dep(i) for i in range(node.n_dep()))
+    return False
 
 
 def _loop(out: SortedDAE, eqs, cols, eq_cols, res, sym, unknowns, names, variables,
