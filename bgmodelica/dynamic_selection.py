@@ -44,7 +44,8 @@ class StateSelector:
                 [ca.vertcat(*[p.sx for p in bound])],
                 [ca.vertcat(*[ca.SX(p.decl.value) for p in bound])], [jac], False)
         free = [p for p in model.parameters if not isinstance(p.decl.value, ca.SX)]
-        p_vec = ca.vertcat(*[p.sx for p in free], *[u.sx for u in model.inputs])
+        p_vec = ca.vertcat(*[p.sx for p in free], *[u.sx for u in model.inputs],
+                           *[d.sx for d in model.discretes])
         self._jac = ca.Function("selection_jacobian", [syms, p_vec, TIME.sx], [jac])
         self.variants[self.key(red.dummies)] = self.base
         self.priority = red.priority

@@ -14,6 +14,7 @@ from bgmodelica import (
     Discrete,
     Integer,
     Parameter,
+    StateSelect,
     Variable,
     der,
     eq,
@@ -28,7 +29,7 @@ from bgmodelica import (
     when,
 )
 
-__all__ = ["BouncingBall", "StickSlip", "PWMMotor"]
+__all__ = ["BouncingBall", "StickSlip", "PWMMotor", "PendulumWall"]
 
 
 class BouncingBall(Component):
@@ -131,3 +132,40 @@ class PWMMotor(Component):
                                 self.Vs, 0.0)
         yield self.L * der(self.i) == self.U - self.R * self.i - self.k * self.w
         yield self.J * der(self.w) == self.k * self.i - self.b * self.w
+
+
+class PendulumWall(Component):
+    """The Cartesian pendulum (index 3) swinging against a vertical wall at ``x = x_wall``.
+
+    When the mass reaches the wall moving towards it, both velocity components are reversed
+    and scaled by ``e`` (the angular velocity jumps to -e times its value; the rod constraint
+    still holds). Index reduction differentiates the constraint twice; the event loop locates
+    the impacts and re-initializes the index-1 system.
+
+    Parameters: L [m], m [kg], g [m/s2], x_wall [m] (< 0), e [1]. Variables: x, y [m],
+    vx, vy [m/s], T [N/m]. Released from rest at x = x0, y = -sqrt(L^2 - x0^2) (x0 = 0.6 m).
+    States: x, vx (preferred; the swing stays below the horizontal, where they are valid).
+    """
+
+    L = Parameter(1.0, unit="m", description="Rod length")
+    m = Parameter(1.0, unit="kg", description="Mass")
+    g = Parameter(9.81, unit="m/s2", description="Gravity along -y")
+    x_wall = Parameter(-0.3, unit="m", description="Position of the wall")
+    e = Parameter(0.8, unit="1", description="Coefficient of restitution")
+    x = Variable(unit="m", start=0.6, fixed=True, state_select=StateSelect.PREFER,
+                 description="Horizontal position")
+    y = Variable(unit="m", start=-0.8, description="Vertical position")
+    vx = Variable(unit="m/s", start=0.0, fixed=True, state_select=StateSelect.PREFER,
+                  description="Horizontal velocity")
+    vy = Variable(unit="m/s", start=0.0, description="Vertical velocity")
+    T = Variable(unit="N/m", description="Rod force per unit length")
+
+    def equations(self):
+        yield der(self.x) == self.vx
+        yield der(self.y) == self.vy
+        yield self.m * der(self.vx) == -self.T * self.x
+        yield self.m * der(self.vy) == -self.T * self.y - self.m * self.g
+        yield self.x**2 + self.y**2 == self.L**2
+        yield when(self.x < self.x_wall,
+                   reinit(self.vx, -self.e * pre(self.vx)),
+                   reinit(self.vy, -self.e * pre(self.vy)))

@@ -290,3 +290,28 @@ def test_open_loop_robot_from_csv_table_with_jump(tmp_path):
     assert len(k) == 2
     assert res["motor1.u"][k[0]] == pytest.approx(4.0) and res["motor1.u"][k[1]] == \
         pytest.approx(-3.0)
+
+
+def test_pendulum_against_wall_high_index_with_impacts():
+    """Index-3 Cartesian pendulum hitting a wall, against the angle ODE with scipy events."""
+    from library.examples.hybrid import PendulumWall
+
+    res = bg.simulate(PendulumWall(), stop_time=5.0, interval=0.01, **TIGHT)
+    assert np.max(np.abs(res["x"] ** 2 + res["y"] ** 2 - 1.0)) < 1e-8
+
+    def wall(_t, s):
+        return math.sin(s[0]) + 0.3
+    wall.terminal, wall.direction = True, -1
+    t, s, impacts = 0.0, [math.asin(0.6), 0.0], []
+    while True:
+        sol = solve_ivp(lambda _t, s: [s[1], -9.81 * math.sin(s[0])], (t, 5.0), s,
+                        events=wall, rtol=1e-12, atol=1e-13, method="DOP853")
+        if not sol.t_events[0].size:
+            break
+        t = sol.t_events[0][0]
+        impacts.append(t)
+        s = [sol.y_events[0][0][0], -0.8 * sol.y_events[0][0][1]]
+    fired = [t for k, t in enumerate(res.meta["event_times"])
+             if k == 0 or t - res.meta["event_times"][k - 1] > 1e-9]
+    assert len(fired) == len(impacts) == 3
+    assert np.max(np.abs(np.array(fired) - impacts)) < 1e-7
