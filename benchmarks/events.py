@@ -41,7 +41,7 @@ def hand_written() -> tuple[float, np.ndarray]:
                       {"abstol": ATOL, "reltol": RTOL})
     period = 1.0 / F_PWM
     xk = np.zeros(2)
-    for n in range(int(round(STOP * F_PWM))):
+    for _ in range(int(round(STOP * F_PWM))):
         xk = F(x0=xk, p=[VS, DUTY * period])["xf"]
         xk = F(x0=xk, p=[0.0, (1.0 - DUTY) * period])["xf"]
     return time.perf_counter() - t0, np.asarray(xk).ravel()

@@ -132,8 +132,11 @@ def test_stick_slip_against_piecewise_closed_form():
         for ta, tb, xa, va, mode in pieces:
             if ta <= t <= tb and not (left and t == ta and ta > 0) and not (
                     not left and t == tb and tb < 10.0 and i > 0 and res.time[i - 1] == t):
-                x, v = motion(ta, xa, va, mode) if mode else (lambda s: xa, lambda s: 0.0)
-                x_ref[i], v_ref[i] = x(t), v(t)
+                if mode:
+                    x, v = motion(ta, xa, va, mode)
+                    x_ref[i], v_ref[i] = x(t), v(t)
+                else:
+                    x_ref[i], v_ref[i] = xa, 0.0
                 break
     assert np.max(np.abs(res["x"] - x_ref)) < 1e-6
     assert np.max(np.abs(res["v"] - v_ref)) < 1e-6
