@@ -7,6 +7,8 @@
 - ``fig14_joint1.png``, ``fig15_joint2.png``: reference vs output per joint (paper style);
 - ``tracking_error.png``: q* - q per joint;
 - ``motors.png``: motor voltages and currents;
+- ``digital_pid.png``: the robot under a sampled PID (:class:`~library.robots.RobotDigitalPID`,
+  Ts = 1 ms, zero-order hold) beside the continuous PID: joint angles and the held voltage;
 - ``summary.json``: the returned summary (max tracking error per joint after 1 s, compile
   and run times, states, solver statistics).
 
@@ -119,6 +121,50 @@ def _figures(res, outdir: Path) -> list[Path]:
     return paths
 
 
+def digital_figure(res_continuous, outdir: Path, stop_time: float = 2.0,
+                   Ts: float = 5e-3) -> tuple[Path, dict[str, float]]:
+    """Simulate :class:`RobotDigitalPID` (sample period ``Ts``) and plot it beside the
+    continuous PID result ``res_continuous``; returns the figure and summary figures."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from bgmodelica import simulate
+
+    from .digital import RobotDigitalPID
+
+    dig = simulate(RobotDigitalPID(), stop_time=stop_time, interval=INTERVAL,
+                   params={"Ts": Ts}, rtol=1e-8, atol=1e-10)
+    cont = res_continuous
+    sel = cont.time <= stop_time
+    fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
+    for j, ax in zip((1, 2), axes[:2], strict=True):
+        ax.plot(cont.time[sel], cont[f"ref{j}.q"][sel], "k:", lw=1, label=f"q{j}* reference")
+        ax.plot(cont.time[sel], cont[f"arm.q{j}"][sel], lw=1.2, label="continuous PID")
+        ax.plot(dig.time, dig[f"arm.q{j}"], "--", lw=1.2, label=f"sampled PID, Ts = {Ts:g} s")
+        ax.set_ylabel(f"q{j} [rad]")
+        ax.grid(alpha=0.3)
+        ax.legend(loc="best", fontsize=8)
+    axes[2].plot(cont.time[sel], cont["motor1.u"][sel], lw=1, label="motor1.u continuous")
+    axes[2].plot(dig.time, dig["motor1.u"], lw=1, drawstyle="steps-post",
+                 label="motor1.u sampled (held)")
+    axes[2].set_ylabel("voltage [V]")
+    axes[2].set_xlabel("time [s]")
+    axes[2].grid(alpha=0.3)
+    axes[2].legend(loc="best", fontsize=8)
+    axes[0].set_title("Two-link robot: continuous vs sampled (digital) PID")
+    fig.tight_layout()
+    path = outdir / "digital_pid.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    info = {"events": float(dig.meta["n_events"]), "run_seconds": float(dig.meta["run_seconds"]),
+            "max_abs_q_difference_rad": float(max(
+                np.max(np.abs(np.interp(dig.time, cont.time, cont[f"arm.q{j}"])
+                              - dig[f"arm.q{j}"])) for j in (1, 2)))}
+    return path, info
+
+
 def run(outdir: Path) -> dict:
     """Simulate the PID robot for 10 s; write CSV, figures and summary into ``outdir``."""
     outdir = Path(outdir)
@@ -127,6 +173,8 @@ def run(outdir: Path) -> dict:
     after = res.time >= SETTLE
     csv_path = res.to_csv(outdir / "robot.csv", CSV_COLUMNS)
     figures = _figures(res, outdir)
+    digital_path, digital = digital_figure(res, outdir)
+    figures.append(digital_path)
     info = compiled.summary()
     summary = {
         "model": "library.robots.robot.RobotPID",
@@ -145,6 +193,7 @@ def run(outdir: Path) -> dict:
         "states": info["states"],
         "algebraic_variables": info["algebraic_variables"],
         "solver_steps": int(res.meta["stats"].get("nsteps", 0)),
+        "digital_pid": digital,
         "csv": str(csv_path),
         "figures": [str(p) for p in figures],
     }
