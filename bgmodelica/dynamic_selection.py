@@ -3,16 +3,18 @@
 Index reduction may leave a choice between candidate states (the Cartesian pendulum: x or y).
 When the Jacobian of the differentiated constraints with respect to the candidates depends on
 the variables, no fixed choice is good everywhere: solving ``x^2 + y^2 = L^2`` for ``y`` fails at
-``y = 0``. The simulation therefore checks, at every output point, the pivots of the current
-choice against the best numerical choice (QR with column pivoting at each dummy-derivative
-level) and, when the current one has fallen below ``threshold`` times the best, recompiles the
-model with the better selection (cached) and continues from the current values of all
-variables. This is Mattsson & Söderlind's dynamic pivoting done between integrator restarts.
+``y = 0``. The event loop (:mod:`bgmodelica.events.loop`) therefore checks, at check points
+inside the integration (independent of the output grid), the pivots of the current choice
+against the best numerical choice (threshold pivoting at each dummy-derivative level) and, when
+the current one has fallen below ``threshold`` times the best, recompiles the model with the
+better selection (cached) and continues from the current values of all variables: the
+integrator restarts only at such switches. This is Mattsson & Söderlind's dynamic pivoting.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -77,9 +79,10 @@ class StateSelector:
             score *= abs(np.linalg.det(jac[np.ix_(rows, chosen)]))
         return score
 
-    def check(self, current: CompiledModel, values: np.ndarray, p: np.ndarray,
-              t: float) -> CompiledModel:
-        """Return the variant to continue with at time ``t`` given all variable values."""
+    def assess(self, current: CompiledModel, values: np.ndarray, p: np.ndarray,
+               t: float) -> tuple[float, float, list[int], Any]:
+        """Pivot scores at time ``t`` given all variable values: ``(score of the current
+        choice, score of the best choice, best dummies, best levels)``."""
         jac = np.asarray(ca.DM(self._jac(values, p, t)))
         red = current.reduced
         now = self._score(jac, red.levels)
@@ -90,15 +93,22 @@ class StateSelector:
         try:
             best = dummy_derivatives(red.graph, self.priority, select=numeric)
         except StructuralError:
-            return current
-        best_score = self._score(jac, best.levels)
+            return now, now, list(red.dummies), red.levels
+        return now, self._score(jac, best.levels), list(best.dummies), best.levels
+
+    def check(self, current: CompiledModel, values: np.ndarray, p: np.ndarray,
+              t: float) -> CompiledModel:
+        """Return the variant to continue with at time ``t`` given all variable values."""
+        now, best_score, dummies, levels = self.assess(current, values, p, t)
         if now >= self.threshold * best_score:
             return current
-        key = self.key(best.dummies)
+        key = self.key(dummies)
         if key not in self.variants:
-            choice = {lvl: chosen for lvl, (_, _, chosen) in enumerate(best.levels, start=1)}
+            choice = {lvl: chosen for lvl, (_, _, chosen) in enumerate(levels, start=1)}
             self.variants[key] = recompile(self.base, lambda lvl, r, c, d: choice.get(lvl, d))
         nxt = self.variants[key]
+        if nxt is current:
+            return current
         self.switches.append((t, list(nxt.dae.state_names)))
         return nxt
 

@@ -65,30 +65,24 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
         raise ParameterError(f"stop_time ({stop_time}) must be after start_time ({start_time})")
     n_int = max(1, int(round((stop_time - start_time) / interval))) if interval else 500
     grid = np.linspace(start_time, stop_time, n_int + 1)
-    if dae.hybrid is not None or inputs is not None:
+    selection = _selection(compiled, dynamic, start_over, stop_time - start_time)
+    if dae.hybrid is not None or inputs is not None or selection is not None:
         from .events.run import simulate_hybrid
 
         return simulate_hybrid(compiled, dae, p, grid, rtol=rtol, atol=atol, max_step=max_step,
                                max_steps=max_steps, outputs=outputs, inputs=inputs,
-                               t_start=t_start)
+                               t_start=t_start, selection=selection, progress=progress)
     init = initialize(dae, p, start_time)
     obs_idx = _output_indices(dae, outputs, compiled.reduced.model.aliases)
     opts = {"abstol": atol, "reltol": rtol, "max_num_steps": max_steps,
             "calc_ic": False}   # initialize() already made x0, z0 consistent
     if max_step is not None:
         opts["max_step_size"] = float(max_step)
-    selector = _selector(compiled) if dynamic else None
-    if selector is not None:
-        values, stats, failure, variants = _integrate_dynamic(selector, grid, init, p, opts,
-                                                              progress)
-        values = values[:, obs_idx]
-        n_ok = values.shape[0]
-    else:
-        xs, zs, stats, failure = _integrate(dae, solver, grid, init.x0, init.z0, p, opts,
-                                            progress)
-        n_ok = xs.shape[1]
-        values = ((lambda: np.asarray(_observer(dae, obs_idx)(grid[:n_ok], xs, zs, p)))
-                  if n_ok else np.zeros((0, len(obs_idx))))
+    xs, zs, stats, failure = _integrate(dae, solver, grid, init.x0, init.z0, p, opts,
+                                        progress)
+    n_ok = xs.shape[1]
+    values = ((lambda: np.asarray(_observer(dae, obs_idx)(grid[:n_ok], xs, zs, p)))
+              if n_ok else np.zeros((0, len(obs_idx))))
     run = _time.perf_counter() - t_start
     names = [dae.names[k] for k in obs_idx]
     flat = compiled.reduced.model
@@ -97,8 +91,6 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
     meta = {"compile_seconds": compiled.compile_time, "run_seconds": run,
             "timings": dict(compiled.timings), "solver": solver, "stats": stats,
             "states": list(dae.state_names), "init_notes": init.notes}
-    if selector is not None:
-        meta["state_switches"] = selector.switches
     kept = set(names)
     aliases = {a: rep for a, rep in flat.aliases.items() if rep[0] in kept}
     result = Result(grid[:n_ok], values, names, aliases, params_out, units, meta)
@@ -397,6 +389,21 @@ def _integrate(dae: CasadiDAE, solver: str, grid: np.ndarray, x0, z0, p, opts, p
     return X, Z, stats, failure
 
 
+def _selection(compiled: CompiledModel, dynamic: bool, start_over: dict[str, Any],
+               span: float):
+    """Dynamic state selection for the event loop when the model's pivots vary with the
+    state: switching (``dynamic=True``) or a check that stops with a clear error when the
+    compiled choice degenerates (``dynamic=False``); None when the choice is fixed."""
+    selector = _selector(compiled)
+    if selector is None:
+        return None
+    from .events.loop import Selection
+
+    return Selection(selector, selector.base, "switch" if dynamic else "check",
+                     (lambda d: _with_starts(d, start_over)) if start_over else None,
+                     spacing=span / 1000.0)
+
+
 def _selector(compiled: CompiledModel):
     """The dynamic state selector of a model that needs one (cached on the model), or None."""
     if not compiled.reduced.has_choice:
@@ -411,72 +418,3 @@ def _selector(compiled: CompiledModel):
     return cached or None
 
 
-class _Stepper:
-    """One IDAS integrator over a single output interval, reused through a time offset."""
-
-    def __init__(self, dae: CasadiDAE, h: float, opts: dict) -> None:
-        t_off = ca.SX.sym("t_offset")
-        tau = ca.SX.sym("tau")
-        ode = ca.substitute(dae.ode, dae.t, tau + t_off)
-        problem = {"x": dae.x, "p": ca.vertcat(dae.p, t_off), "t": tau, "ode": ode}
-        if dae.z.numel():
-            problem.update(z=dae.z, alg=ca.substitute(dae.alg, dae.t, tau + t_off))
-        self.F = ca.integrator("step", "idas", problem, 0.0, [float(h)],
-                               {**opts, "calc_ic": True})
-        self.obs = ca.Function("observe_all", [dae.t, dae.x, dae.z, dae.p], [dae.observed])
-        self.dae = dae
-
-    def observe(self, t: float, x, z, p) -> np.ndarray:
-        return np.asarray(self.obs(t, x, z, p)).ravel()
-
-
-def _integrate_dynamic(selector, grid, init, p, opts, progress):
-    """Integrate interval by interval, re-selecting states where the choice degrades."""
-    h = float(grid[1] - grid[0])
-    steppers: dict[int, _Stepper] = {}
-
-    def stepper(c: CompiledModel) -> _Stepper:
-        if id(c) not in steppers:
-            steppers[id(c)] = _Stepper(c.dae, h, opts)
-        return steppers[id(c)]
-
-    def restart(c: CompiledModel, v: np.ndarray):
-        idx = c.dae.observed_index
-        return (np.array([v[idx[n]] for n in c.dae.state_names]),
-                np.array([v[idx[n]] for n in c.dae.algebraic_names]))
-
-    current = selector.base
-    xk, zk = init.x0, init.z0
-    first = stepper(current).observe(grid[0], xk, zk, p)
-    bad = ~np.isfinite(first)          # the default choice may be singular at the start
-    if bad.any():
-        starts = [float(getattr(v.decl, "start", 0.0)) for v in current.reduced.model.variables]
-        first[bad] = np.asarray(starts)[bad]
-    nxt = selector.check(current, first, p, float(grid[0]))
-    if nxt is not current:
-        current = nxt
-        again = initialize(current.dae, p, float(grid[0]))
-        xk, zk = again.x0, again.z0
-        first = stepper(current).observe(grid[0], xk, zk, p)
-    values = [first]
-    stats: dict[str, Any] = {}
-    failure = None
-    for k in range(1, len(grid)):
-        st = stepper(current)
-        try:
-            out = st.F(x0=xk, z0=zk, p=np.concatenate([p, [grid[k - 1]]]))
-        except RuntimeError as err:
-            failure = str(err)
-            break
-        xk = np.asarray(out["xf"]).ravel()
-        zk = np.asarray(out["zf"]).ravel()
-        for key, val in st.F.stats().items():
-            if isinstance(val, (int, float)) and not isinstance(val, bool):
-                stats[key] = stats.get(key, 0) + val
-        values.append(st.observe(grid[k], xk, zk, p))
-        nxt = selector.check(current, values[-1], p, float(grid[k]))
-        if nxt is not current:
-            current, (xk, zk) = nxt, restart(nxt, values[-1])
-        if progress is not None and k % max(1, len(grid) // 20) == 0:
-            progress(k / (len(grid) - 1))
-    return np.vstack(values), stats, failure, selector.variants

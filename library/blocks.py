@@ -2,8 +2,15 @@
 
 Signals are plain ``Input``/``Output`` variables: ``u``, ``u1``, ``u2`` in, ``y`` out, joined
 with ``connect(a.y, b.u)``. Units are left empty (signals are dimensionless unless the
-connected quantity says otherwise). Sources depending on ``time`` switch with ``if_else``:
-there is no event handling, a step is a discontinuity met by the integrator's error control.
+connected quantity says otherwise). Sources depending on ``time`` switch with ``if_else`` on a
+relation of ``time``, which is a time event (hit exactly).
+
+Event blocks (Modelica semantics, see :mod:`bgmodelica.core.hybrid`): ``Relay`` (hysteresis)
+and ``LimiterEvents`` switch at state events (zero crossings of their relations);
+``Sampler``, ``ZeroOrderHold``, ``UnitDelay`` and ``DiscretePID`` act at the time events
+``sample(start_time, Ts)``; ``PWM`` and ``TimeTable`` switch at exact time events. At an
+event instant a result has two rows with the same time: the left limit, then the right limit.
+State events need a model with at least one continuous state (an event-loop limitation).
 
 Initial values: a block with a state (``Integrator``, ``FirstOrder``, ``Derivative``,
 ``LimPID``) fixes it through its ``*_start`` constructor argument, a fixed start value that
@@ -12,20 +19,34 @@ Initial values: a block with a state (``Integrator``, ``FirstOrder``, ``Derivati
 
 from __future__ import annotations
 
+import csv
+from pathlib import Path
+
+import numpy as np
+
 from bgmodelica import (
+    Boolean,
     Component,
+    Discrete,
     Input,
     Output,
     Parameter,
     Variable,
     der,
+    initial,
+    pre,
+    sample,
     sin,
     time,
+    time_table,
+    when,
 )
 from bgmodelica.core.expressions import fmax, fmin, if_else
 
 __all__ = ["Constant", "Step", "Sine", "Ramp", "Gain", "Add", "Feedback", "Product",
-           "Limiter", "Integrator", "FirstOrder", "Derivative", "LimPID"]
+           "Limiter", "Integrator", "FirstOrder", "Derivative", "LimPID",
+           "Relay", "LimiterEvents", "Sampler", "ZeroOrderHold", "UnitDelay", "DiscretePID",
+           "PWM", "TimeTable"]
 
 _PI = 3.141592653589793
 
@@ -287,3 +308,276 @@ class LimPID(Component):
             yield self.x_d == 0
         yield self.y_unlim == self.k * (self.P + self.x_i + self.D)
         yield self.y == fmax(self.y_min, fmin(self.y_max, self.y_unlim))
+
+
+# -- event blocks -------------------------------------------------------------------------------
+
+
+class Relay(Component):
+    """Relay with hysteresis (Modelica.Blocks.Logical.Hysteresis with a Real output).
+
+    The Boolean state ``on`` switches on when u > uHigh and off when u < uLow::
+
+        on = (not pre(on) and u > uHigh) or (pre(on) and u >= uLow)
+        y = if on then y_on else y_off
+
+    Both relations are state events, located to the event tolerance.
+    Input: u. Output: y. Parameters: uLow [1], uHigh [1] (uLow < uHigh), y_on [1], y_off [1].
+    Discrete: on (Boolean). Constructor: pre_y_start (False; the value of pre(on) at the start).
+    """
+
+    uLow = Parameter(0.0, description="Lower switching threshold (off when u < uLow)")
+    uHigh = Parameter(1.0, description="Upper switching threshold (on when u > uHigh)")
+    y_on = Parameter(1.0, description="Output while on")
+    y_off = Parameter(0.0, description="Output while off")
+    u = Input(description="Input signal")
+    y = Output(description="y_on while on, else y_off")
+    on = Boolean(start=False, description="Relay state")
+
+    def __init__(self, pre_y_start: bool = False, **modifiers):
+        super().__init__(**{"on": dict(start=float(bool(pre_y_start)), fixed=False),
+                            **modifiers})
+
+    def equations(self):
+        was_on = pre(self.on)
+        yield self.on == ((~was_on & (self.u > self.uHigh)) | (was_on & (self.u >= self.uLow)))
+        yield self.y == if_else(self.on, self.y_on, self.y_off)
+
+
+class LimiterEvents(Component):
+    """Saturation with events at its corners:
+    ``y = if u > u_max then u_max elseif u < u_min then u_min else u``.
+
+    Unlike :class:`Limiter` (continuous, no events) the relations u > u_max and u < u_min are
+    state events, so the integrator restarts exactly at the corners.
+    Input: u. Output: y. Parameters: u_max, u_min [1].
+    """
+
+    u_max = Parameter(1.0, description="Upper limit")
+    u_min = Parameter(-1.0, description="Lower limit")
+    u = Input(description="Input signal")
+    y = Output(description="Limited output")
+
+    def equations(self):
+        yield self.y == if_else(self.u > self.u_max, self.u_max,
+                                if_else(self.u < self.u_min, self.u_min, self.u))
+
+
+class Sampler(Component):
+    """Ideal sampler (Modelica.Blocks.Discrete.Sampler): at the start and at every instant
+    ``start_time + k*Ts`` (k = 0, 1, ...) the output takes the input's value and holds it.
+
+    Input: u. Output: y (piecewise constant). Parameters: Ts [s] (> 0), start_time [s].
+    Discrete: y_sample (the last sampled value).
+    """
+
+    Ts = Parameter(0.1, unit="s", description="Sample period")
+    start_time = Parameter(0.0, unit="s", description="First sample instant")
+    u = Input(description="Continuous input signal")
+    y = Output(description="Sampled and held input")
+    y_sample = Discrete(start=0.0, description="Last sampled value of u")
+
+    def equations(self):
+        yield when([sample(self.start_time, self.Ts), initial()], self.y_sample == self.u)
+        yield self.y == self.y_sample
+
+
+class ZeroOrderHold(Component):
+    """Zero-order hold (Modelica.Blocks.Discrete.ZeroOrderHold): samples u at the start and at
+    ``start_time + k*Ts`` and outputs ``y = pre(y_sample)``, the sampled value with an
+    infinitesimal delay (so a loop through the hold and a direct-feedthrough plant is not an
+    algebraic loop). After each sample instant y equals the new sample.
+
+    Input: u. Output: y. Parameters: Ts [s] (> 0), start_time [s].
+    Discrete: y_sample (the last sampled value).
+    """
+
+    Ts = Parameter(0.1, unit="s", description="Sample period")
+    start_time = Parameter(0.0, unit="s", description="First sample instant")
+    u = Input(description="Continuous input signal")
+    y = Output(description="Held input")
+    y_sample = Discrete(start=0.0, description="Last sampled value of u")
+
+    def equations(self):
+        yield when([sample(self.start_time, self.Ts), initial()], self.y_sample == self.u)
+        yield self.y == pre(self.y_sample)
+
+
+class UnitDelay(Component):
+    """Unit delay ``y = u/z``: at the sample instants t_k = start_time + k*Ts the output takes
+    the input sampled at the previous instant, ``y_k = u_(k-1)``, with ``y_0 = y_start``
+    (and y = y_start before the first sample); y is held between samples.
+
+    Input: u. Output: y. Parameters: Ts [s] (> 0), start_time [s]. Constructor: y_start (0).
+    Discrete: u_last (u at the last sample), y_hold (the output).
+    """
+
+    Ts = Parameter(0.1, unit="s", description="Sample period")
+    start_time = Parameter(0.0, unit="s", description="First sample instant")
+    u = Input(description="Continuous input signal")
+    y = Output(description="Input delayed by one sample")
+    u_last = Discrete(start=0.0, description="Input at the last sample instant")
+    y_hold = Discrete(start=0.0, description="Held output")
+
+    def __init__(self, y_start: float = 0.0, **modifiers):
+        super().__init__(**{"u_last": y_start, "y_hold": y_start, **modifiers})
+
+    def equations(self):
+        yield when(sample(self.start_time, self.Ts),
+                   self.y_hold == pre(self.u_last),
+                   self.u_last == self.u)
+        yield self.y == self.y_hold
+
+
+class DiscretePID(Component):
+    """Sampled PID with output limits, period Ts. At every sample instant t_k = k*Ts
+    (k = 0, 1, ...)::
+
+        e_k = u_s(t_k) - u_m(t_k)
+        I_k = I_(k-1) + Ts*e_k                       (I_(-1) = 0)
+        D_k = (e_k - e_(k-1))/Ts                     (e_(-1) = e_0, so D_0 = 0)
+        y_k = clamp(Kp*e_k + Ki*I_k + Kd*D_k, y_min, y_max)
+
+    and y = y_k on [t_k, t_(k+1)) (held; no anti-windup beyond the clamp of the output).
+    Inputs: u_s (setpoint), u_m (measurement). Output: y. Parameters: Kp [1], Ki [1/s],
+    Kd [s], Ts [s] (> 0), y_max, y_min [1]. Discrete: e (last sampled error), I (sum of
+    Ts*e), y_hold (the output), first (Boolean, true before the first sample).
+    """
+
+    Kp = Parameter(1.0, description="Proportional gain")
+    Ki = Parameter(0.0, unit="1/s", description="Integral gain")
+    Kd = Parameter(0.0, unit="s", description="Derivative gain")
+    Ts = Parameter(0.01, unit="s", description="Sample period")
+    y_max = Parameter(1.0, description="Upper output limit")
+    y_min = Parameter(-1.0, description="Lower output limit")
+    u_s = Input(description="Setpoint")
+    u_m = Input(description="Measurement")
+    y = Output(description="Held, limited controller output")
+    e = Discrete(start=0.0, description="Error at the last sample")
+    I = Discrete(start=0.0, unit="s", description="Sum of Ts*e over the samples")  # noqa: E741
+    y_hold = Discrete(start=0.0, description="Output computed at the last sample")
+    first = Boolean(start=True, description="No sample taken yet")
+
+    def equations(self):
+        e_k = self.u_s - self.u_m
+        i_k = pre(self.I) + self.Ts * e_k
+        d_k = if_else(pre(self.first), 0.0, (e_k - pre(self.e)) / self.Ts)
+        raw = self.Kp * e_k + self.Ki * i_k + self.Kd * d_k
+        yield when(sample(0.0, self.Ts),
+                   self.e == e_k,
+                   self.I == i_k,
+                   self.y_hold == fmax(self.y_min, fmin(self.y_max, raw)),
+                   self.first == False)  # noqa: E712 -- assigns the Boolean
+        yield self.y == self.y_hold
+
+
+class PWM(Component):
+    """Pulse-width-modulated source: y = V while frac((time - start_time)*f) < duty, else 0
+    (and 0 before start_time).
+
+    Each period starts at ``sample(start_time, 1/f)`` (the output goes high) and the output
+    goes low at the time event period start + duty/f (a relation on time), so both edges are
+    exact time events.
+    Output: y. Parameters: V [1] (high value), f [Hz] (> 0), duty [1] (0..1), start_time [s].
+    Discrete: period_start [s] (start of the current period), on (Boolean, the output is high).
+    """
+
+    V = Parameter(1.0, description="Output while high")
+    f = Parameter(1.0, unit="Hz", description="PWM frequency")
+    duty = Parameter(0.5, unit="1", description="Duty cycle (high fraction of each period)")
+    start_time = Parameter(0.0, unit="s", description="Start of the first period")
+    y = Output(description="V while high, else 0")
+    period_start = Discrete(unit="s", start=0.0, description="Start of the current period")
+    on = Boolean(start=False, description="True while the output is high")
+
+    def equations(self):
+        yield when(sample(self.start_time, 1.0 / self.f), self.period_start == time)
+        yield self.on == ((time >= self.start_time)
+                          & (time < self.period_start + self.duty / self.f))
+        yield self.y == if_else(self.on, self.V, 0.0)
+
+
+class TimeTable(Component):
+    """Table look-up in time, one output column (like Modelica.Blocks.Sources.CombiTimeTable).
+
+    ``y = offset + table(time)``, built on :func:`bgmodelica.time_table`: breakpoints are time
+    events, so kinks and jumps are hit exactly.
+
+    Output: y. Parameter: offset [1].
+    Constructor arguments (fixed at construction):
+
+    - ``table``: an N x M array (column 1 is time [s], non-decreasing) or the path of a CSV
+      file with a header row (first column time).
+    - ``column``: the output column, 1-based as in Modelica (column 1 is time, so the default
+      2 is the first value column) or a header name of the CSV file.
+    - ``smoothness``: "linear" (linear interpolation) or "hold" (constant from each breakpoint
+      to the next). A repeated time is a jump: the later row holds from that instant.
+    - ``extrapolation``: "hold" (first/last value), "periodic" (the table repeats with period
+      t_last - t_first) or "linear" (first/last segment continued; with "linear" smoothness).
+    - ``timeScale`` [s] (> 0): the table's time column is in units of timeScale seconds
+      (a table time t_tab is the model time t_tab*timeScale).
+    """
+
+    offset = Parameter(0.0, description="Offset added to the table value")
+    y = Output(description="Table value at time (plus offset)")
+
+    def __init__(self, table, column: int | str = 2, smoothness: str = "linear",
+                 extrapolation: str = "hold", timeScale: float = 1.0, **modifiers):  # noqa: N803
+        data, names = _read_table(table)
+        if isinstance(column, str):
+            if names is None or column not in names:
+                raise ValueError(f"TimeTable: no column named {column!r}"
+                                 + (f" (columns: {names})" if names else
+                                    " (the table has no header; give a 1-based index)"))
+            index = names.index(column) + 1
+        else:
+            index = int(column)
+        if not 2 <= index <= data.shape[1]:
+            raise ValueError(f"TimeTable: column must be 2..{data.shape[1]} (1-based; column 1 "
+                             f"is time), got {column!r}")
+        if smoothness not in ("linear", "hold"):
+            raise ValueError(f"TimeTable: smoothness must be 'linear' or 'hold', got "
+                             f"{smoothness!r}")
+        if extrapolation not in ("hold", "periodic", "linear"):
+            raise ValueError(f"TimeTable: extrapolation must be 'hold', 'periodic' or 'linear', "
+                             f"got {extrapolation!r}")
+        if not (np.isfinite(timeScale) and timeScale > 0):
+            raise ValueError(f"TimeTable: timeScale must be > 0, got {timeScale!r}")
+        object.__setattr__(self, "_times", data[:, 0] * float(timeScale))
+        object.__setattr__(self, "_values", data[:, index - 1].copy())
+        object.__setattr__(self, "_smoothness", smoothness)
+        object.__setattr__(self, "_extrapolation", extrapolation)
+        super().__init__(**modifiers)
+
+    def equations(self):
+        yield self.y == self.offset + time_table(self._times, self._values, self._smoothness,
+                                                 self._extrapolation)
+
+
+def _read_table(table) -> tuple[np.ndarray, list[str] | None]:
+    """(N x M float array, header names or None) from an array or a CSV path with a header."""
+    names = None
+    if isinstance(table, (str, Path)):
+        path = Path(table)
+        if not path.is_file():
+            raise ValueError(f"TimeTable: table file {path} does not exist")
+        with path.open(newline="") as fh:
+            rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
+        if len(rows) < 2:
+            raise ValueError(f"TimeTable: {path} needs a header row and data rows")
+        names = [h.strip() for h in rows[0]]
+        try:
+            data = np.array([[float(v) for v in r] for r in rows[1:]], dtype=float)
+        except ValueError as err:
+            raise ValueError(f"TimeTable: {path}: {err}") from None
+        if data.ndim != 2 or data.shape[1] != len(names):
+            raise ValueError(f"TimeTable: {path}: rows and header have different numbers of "
+                             "columns")
+    else:
+        data = np.array(table, dtype=float)
+        if data.ndim != 2:
+            raise ValueError(f"TimeTable: table must be an N x M array, got shape {data.shape}")
+    if data.shape[0] < 1 or data.shape[1] < 2:
+        raise ValueError(f"TimeTable: table needs a time column and a value column, got shape "
+                         f"{data.shape}")
+    return data, names

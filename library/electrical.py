@@ -6,6 +6,7 @@ Connector :class:`Pin`: potential ``v`` [V], flow ``i`` [A] (positive into the c
 from __future__ import annotations
 
 from bgmodelica import (
+    Boolean,
     Component,
     Connector,
     Flow,
@@ -24,7 +25,11 @@ from .rotational import Flange
 
 __all__ = ["Pin", "OnePort", "Ground", "Resistor", "Capacitor", "Inductor", "ConstantVoltage",
            "StepVoltage", "SineVoltage", "SignalVoltage", "ConstantCurrent", "StepCurrent",
-           "SineCurrent", "SignalCurrent", "EMF", "VoltageSensor", "CurrentSensor"]
+           "SineCurrent", "SignalCurrent", "EMF", "VoltageSensor", "CurrentSensor",
+           "IdealSemiconductor", "IdealDiode", "IdealSwitch", "IdealOpeningSwitch",
+           "IdealClosingSwitch", "PartialCommutingSwitch", "IdealCommutingSwitch",
+           "ControlledIdealOpeningSwitch", "ControlledIdealClosingSwitch",
+           "ControlledIdealCommutingSwitch"]
 
 
 class Pin(Connector):
@@ -225,3 +230,209 @@ class CurrentSensor(Component):
         yield self.p.v == self.n.v
         yield self.p.i + self.n.i == 0
         yield self.i == self.p.i
+
+
+# -- ideal switching elements (Modelica.Electrical.Analog.Ideal) ---------------------------------
+#
+# Each is piecewise linear in an auxiliary variable ``s`` (a parametric description of the
+# characteristic, so the equations stay regular in both modes): with the Boolean ``off``,
+#     v = s*(if off then 1 else Ron) [+ Vknee],    i = s*(if off then Goff else 1) [+ Goff*Vknee].
+# ``off`` changes only at events: a zero crossing of a relation (diode, controlled switches) or
+# a change of the Boolean control signal. Units of s: V while off, A while on (MSL multiplies by
+# constants of 1 V / 1 A; here s carries unit "1").
+
+
+class IdealSemiconductor(OnePort):
+    """Ideal semiconductor (Modelica.Electrical.Analog.Interfaces.IdealSemiconductor).
+
+    Piecewise linear: conducting (``off`` false) it is a resistance Ron in series with the knee
+    voltage Vknee, blocking (``off`` true) a conductance Goff::
+
+        off = s < 0
+        v = s*(if off then 1 else Ron) + Vknee
+        i = s*(if off then Goff else 1) + Goff*Vknee
+
+    so at the switching point s = 0 both branches give v = Vknee, i = Goff*Vknee (continuous
+    characteristic). The relation ``s < 0`` is a state event.
+    Tolerances: while conducting, ``i = (v - Vknee)/Ron`` amplifies the integration error of
+    the circuit's voltages by 1/Ron; with Ron = 1e-5 Ohm at ~10 V use rtol <= 1e-8, or the
+    current's error (up to ~rtol*10 V/Ron) can reach zero before the real turn-off and cause
+    spurious off/on event pairs.
+    Parameters: Ron [Ohm] (>= 0), Goff [S] (>= 0), Vknee [V] (>= 0).
+    Variables: s [1] (auxiliary); Boolean ``off`` (start true).
+    """
+
+    Ron = Parameter(1e-5, unit="Ohm", min=0.0, description="Forward state-on differential "
+                    "resistance (closed resistance)")
+    Goff = Parameter(1e-5, unit="S", min=0.0, description="Backward state-off conductance "
+                     "(opened conductance)")
+    Vknee = Parameter(0.0, unit="V", min=0.0, description="Forward threshold voltage")
+    off = Boolean(start=True, description="Switching state (true: blocking)")
+    s = Variable(unit="1", start=0.0, description="Auxiliary variable for the characteristic: "
+                 "actual current if conducting, actual voltage if blocking (minus Vknee)")
+
+    def equations(self):
+        yield self.off == (self.s < 0)
+        yield self.v == self.s * if_else(self.off, 1.0, self.Ron) + self.Vknee
+        yield self.i == self.s * if_else(self.off, self.Goff, 1.0) + self.Goff * self.Vknee
+
+
+class IdealDiode(IdealSemiconductor):
+    """Ideal diode (Modelica.Electrical.Analog.Ideal.IdealDiode): conducting for s >= 0 with
+    ``v = Ron*i + Vknee`` (i >= Goff*Vknee), blocking for s < 0 with ``i = Goff*v``
+    (v < Vknee). Pins: p (anode), n (cathode).
+
+    Parameters: Ron [Ohm] = 1e-5, Goff [S] = 1e-5, Vknee [V] = 0.
+    Variables: v [V], i [A] (p -> n), s [1]; Boolean ``off``. See :class:`IdealSemiconductor`.
+    """
+
+
+class IdealSwitch(OnePort):
+    """Partial ideal switch (Modelica.Electrical.Analog.Interfaces.IdealSwitch)::
+
+        v = s*(if off then 1 else Ron),    i = s*(if off then Goff else 1)
+
+    closed (``off`` false): a resistance Ron; open (``off`` true): a conductance Goff.
+    A subclass defines the Boolean ``off``.
+    Parameters: Ron [Ohm] (>= 0), Goff [S] (>= 0). Variables: s [1]; Boolean ``off``.
+    """
+
+    Ron = Parameter(1e-5, unit="Ohm", min=0.0, description="Closed switch resistance")
+    Goff = Parameter(1e-5, unit="S", min=0.0, description="Opened switch conductance")
+    off = Boolean(start=False, description="Switch state (true: open)")
+    s = Variable(unit="1", start=0.0, description="Auxiliary variable: current if closed, "
+                 "voltage if open")
+
+    def equations(self):
+        yield self.v == self.s * if_else(self.off, 1.0, self.Ron)
+        yield self.i == self.s * if_else(self.off, self.Goff, 1.0)
+
+
+class IdealOpeningSwitch(IdealSwitch):
+    """Ideal electrical opener (Modelica.Electrical.Analog.Ideal.IdealOpeningSwitch):
+    ``off = control``: control true => switch open (conductance Goff), false => p--n
+    connected (resistance Ron).
+
+    Boolean input: ``control`` (a signal, 1 = true, 0 = false; it should change only at
+    events, e.g. a time relation or a Boolean of a block). Parameters: Ron [Ohm] = 1e-5,
+    Goff [S] = 1e-5. See :class:`IdealSwitch`.
+    """
+
+    control = Input(description="true (1) => switch open, false (0) => p--n connected")
+
+    def equations(self):
+        yield self.off == self.control
+
+
+class IdealClosingSwitch(IdealSwitch):
+    """Ideal electrical closer (Modelica.Electrical.Analog.Ideal.IdealClosingSwitch):
+    ``off = not control``: control true => p--n connected (resistance Ron), false => switch
+    open (conductance Goff).
+
+    Boolean input: ``control`` (1 = true, 0 = false). Parameters: Ron [Ohm] = 1e-5,
+    Goff [S] = 1e-5. See :class:`IdealSwitch`.
+    """
+
+    control = Input(description="true (1) => p--n connected, false (0) => switch open")
+
+    def equations(self):
+        yield self.off == ~self.control
+
+
+class PartialCommutingSwitch(Component):
+    """Pins, parameters and equations shared by the commuting switches (no equations of its
+    own; a subclass yields ``self.switched(to_n2)`` with its Boolean condition ``to_n2``)::
+
+        0 = p.i + n1.i + n2.i
+        p.v - n1.v = s1*(if to_n2 then 1 else Ron),   n1.i = -s1*(if to_n2 then Goff else 1)
+        p.v - n2.v = s2*(if to_n2 then Ron else 1),   n2.i = -s2*(if to_n2 then 1 else Goff)
+
+    Pins: p, n1, n2 (currents positive into the switch). Parameters: Ron [Ohm] (>= 0),
+    Goff [S] (>= 0). Variables: s1, s2 [1] (auxiliary: current if closed, voltage if open).
+    """
+
+    Ron = Parameter(1e-5, unit="Ohm", min=0.0, description="Closed switch resistance")
+    Goff = Parameter(1e-5, unit="S", min=0.0, description="Opened switch conductance")
+    p = Pin()
+    n1 = Pin()
+    n2 = Pin()
+    s1 = Variable(unit="1", start=0.0, description="Auxiliary variable of the p--n1 path")
+    s2 = Variable(unit="1", start=0.0, description="Auxiliary variable of the p--n2 path")
+
+    def switched(self, to_n2):
+        """The switch equations with ``to_n2`` (true: p--n2 connected, p--n1 open)."""
+        yield 0 == self.p.i + self.n1.i + self.n2.i
+        yield self.p.v - self.n1.v == self.s1 * if_else(to_n2, 1.0, self.Ron)
+        yield self.n1.i == -self.s1 * if_else(to_n2, self.Goff, 1.0)
+        yield self.p.v - self.n2.v == self.s2 * if_else(to_n2, self.Ron, 1.0)
+        yield self.n2.i == -self.s2 * if_else(to_n2, 1.0, self.Goff)
+
+
+class IdealCommutingSwitch(PartialCommutingSwitch):
+    """Ideal commuting switch (Modelica.Electrical.Analog.Ideal.IdealCommutingSwitch):
+    control true => p--n2 connected (p--n1 open), false => p--n1 connected (p--n2 open).
+    Equations of :class:`PartialCommutingSwitch` with ``to_n2 = control``.
+
+    Pins: p, n1, n2. Boolean input: ``control`` (1 = true, 0 = false). Parameters:
+    Ron [Ohm] = 1e-5, Goff [S] = 1e-5. Variables: s1, s2 [1].
+    """
+
+    control = Input(description="true (1) => p--n2 connected, false (0) => p--n1 connected")
+
+    def equations(self):
+        yield from self.switched(self.control)
+
+
+class ControlledIdealOpeningSwitch(IdealSwitch):
+    """Controlled ideal electrical opener
+    (Modelica.Electrical.Analog.Ideal.ControlledIdealOpeningSwitch): ``off = control.v >
+    level``: control.v > level => switch open (conductance Goff), otherwise p--n connected
+    (resistance Ron). The control pin draws no current; its potential (against ground) is
+    compared to ``level`` by a relation, i.e. the switch changes at a state event.
+
+    Pins: p, n, control. Parameters: level [V] = 0.5, Ron [Ohm] = 1e-5, Goff [S] = 1e-5.
+    See :class:`IdealSwitch`.
+    """
+
+    level = Parameter(0.5, unit="V", description="Switch level")
+    control = Pin()
+
+    def equations(self):
+        yield self.control.i == 0
+        yield self.off == (self.control.v > self.level)
+
+
+class ControlledIdealClosingSwitch(IdealSwitch):
+    """Controlled ideal electrical closer
+    (Modelica.Electrical.Analog.Ideal.ControlledIdealClosingSwitch): ``off = not (control.v >
+    level)``: control.v > level => p--n connected (resistance Ron), otherwise switch open
+    (conductance Goff). The control pin draws no current; the relation is a state event.
+
+    Pins: p, n, control. Parameters: level [V] = 0.5, Ron [Ohm] = 1e-5, Goff [S] = 1e-5.
+    See :class:`IdealSwitch`.
+    """
+
+    level = Parameter(0.5, unit="V", description="Switch level")
+    control = Pin()
+
+    def equations(self):
+        yield self.control.i == 0
+        yield self.off == ~(self.control.v > self.level)
+
+
+class ControlledIdealCommutingSwitch(PartialCommutingSwitch):
+    """Controlled ideal commuting switch
+    (Modelica.Electrical.Analog.Ideal.ControlledIdealCommutingSwitch): control.v > level =>
+    p--n2 connected, otherwise p--n1 connected (equations of :class:`PartialCommutingSwitch`
+    with ``to_n2`` the relation ``control.v > level``, a state event).
+
+    Pins: p, n1, n2, control (draws no current). Parameters: level [V] = 0.5,
+    Ron [Ohm] = 1e-5, Goff [S] = 1e-5. Variables: s1, s2 [1].
+    """
+
+    level = Parameter(0.5, unit="V", description="Switch level")
+    control = Pin()
+
+    def equations(self):
+        yield self.control.i == 0
+        yield from self.switched(self.control.v > self.level)

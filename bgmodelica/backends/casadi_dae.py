@@ -132,8 +132,10 @@ def build_dae(sorted_dae: SortedDAE) -> CasadiDAE:
 
     names = [v.name for v in variables] + [d.name for d in shown]
     observed_index = {n: k for k, n in enumerate(names)}
+    # a discrete variable's start value is its pre() value before the first event, not a
+    # condition on the continuous initial state
     fixed = [(k, float(v.decl.start)) for k, v in enumerate(variables)
-             if v.der_of < 0 and getattr(v.decl, "fixed", False)]
+             if v.der_of < 0 and getattr(v.decl, "fixed", False) and v.decl.kind != "discrete"]
     p = ca.vertcat(*[q.sx for q in free_params], *[u.sx for u in model.inputs],
                    *[d.sx for d in model.discretes])
     return CasadiDAE(

@@ -13,6 +13,7 @@ import casadi as ca
 import numpy as np
 
 from ..backends.casadi_dae import CasadiDAE
+from ..core.flatmodel import HybridPart
 from ..errors import EquationError
 
 
@@ -37,14 +38,14 @@ class HybridFunctions:
 
     @property
     def relations(self):
-        return self.dae.hybrid.relations
+        return self.dae.hybrid.relations if self.dae.hybrid is not None else []
 
 
 def build(dae: CasadiDAE) -> HybridFunctions:
     """Build (once per DAE, cached in ``dae.cache``) the hybrid functions."""
     if "hybrid" in dae.cache:
         return dae.cache["hybrid"]
-    hyb = dae.hybrid
+    hyb = dae.hybrid or HybridPart()
     t, x, z, p = dae.t, dae.x, dae.z, dae.p
     nb = dae.n_base
     rels = hyb.relations
@@ -74,6 +75,15 @@ def build(dae: CasadiDAE) -> HybridFunctions:
         branch_of.append(ids)
     for name, _ in (r for ro in reinit_of for r in ro):
         _check_reinit_target(dae, name)
+    for w in hyb.whens:
+        for b in w.branches:
+            for slot, value in b.assignments:
+                if ca.depends_on(value, p[nb + slot]):
+                    name = dae.discretes[slot].name
+                    raise EquationError(
+                        f"{w.origin}: when {b.text}: the value assigned to {name} depends on "
+                        f"{name} itself through the model's equations (an algebraic loop at the "
+                        f"event); assign from pre({name}) or break the loop")
     pre_src, pre_disc = [], []
     for _slot, name in hyb.pre:
         expr, discrete = _value_of(dae, name)
@@ -83,11 +93,13 @@ def build(dae: CasadiDAE) -> HybridFunctions:
     discrete_obs = [dae.observed_index[n] for n in sorted(dae.discrete_names)
                     if dae.observed_index[n] < dae.n_variables]
     vec = lambda items: ca.vertcat(*items) if items else ca.SX(0, 1)  # noqa: E731
+    # dense outputs: the buffered evaluation (events.fast) returns the stored entries only
     step = ca.Function("event_step", [t, x, z, p],
-                       [g_all, dgdt, vec(conds), vec(assigns), vec(reinits), vec(pre_src), obs],
+                       [ca.densify(e) for e in (g_all, dgdt, vec(conds), vec(assigns),
+                                                 vec(reinits), vec(pre_src), obs)],
                        ["t", "x", "z", "p"],
                        ["g", "dgdt", "cond", "assign", "reinit", "pre", "obs"])
-    indicators = ca.Function("indicators", [t, x, z, p], [g_state])
+    indicators = ca.Function("indicators", [t, x, z, p], [ca.densify(g_state)])
     alg_solver = None
     if z.numel():
         g = ca.Function("alg", [z, ca.vertcat(t, x, p)], [dae.alg])

@@ -25,6 +25,7 @@ import numpy as np
 
 from ..backends.casadi_dae import CasadiDAE
 from ..backends.casadi_init import initialize
+from ..core.flatmodel import HybridPart
 from ..errors import SimulationError
 from .fast import Fast
 from .functions import HybridFunctions, build
@@ -49,6 +50,28 @@ class EventOptions:
 
 
 @dataclass
+class Selection:
+    """Dynamic state selection inside the event loop (see :mod:`bgmodelica.dynamic_selection`).
+
+    selector: the model's StateSelector; current: the variant in use; mode: "switch" (change
+    the states when the pivot test says so) or "check" (keep the states; raise when their
+    pivots degenerate below ``fail_ratio`` times the best); prepare: applies start-value
+    overrides to a variant's DAE; spacing: largest time between two pivot checks [s]."""
+
+    selector: Any
+    current: Any
+    mode: str = "switch"
+    prepare: Any = None
+    spacing: float = math.inf
+    fail_ratio: float = 1e-3
+
+    @property
+    def stretch(self) -> float:
+        """Longest integration between restarts [s] (100 pivot checks)."""
+        return 100.0 * self.spacing
+
+
+@dataclass
 class EventLog:
     times: list[float] = field(default_factory=list)
     kinds: list[str] = field(default_factory=list)
@@ -60,9 +83,14 @@ class HybridSimulator:
 
     def __init__(self, dae: CasadiDAE, p: np.ndarray, rtol: float, atol: float,
                  max_step: float | None, max_steps: int, obs_idx: list[int],
-                 options: EventOptions | None = None) -> None:
+                 options: EventOptions | None = None, selection: Selection | None = None
+                 ) -> None:
+        if dae.hybrid is None:
+            dae = replace(dae, hybrid=HybridPart())
         self.dae = dae
         self.fn: HybridFunctions = build(dae)
+        self.selection = selection
+        self._pending = None
         self.p = np.array(p, dtype=float)
         self.opts = options or EventOptions()
         self.obs_idx = obs_idx
@@ -77,7 +105,7 @@ class HybridSimulator:
         self._sol_opts = sol_opts
         self._opts_key = tuple(sorted(sol_opts.items()))
         self._one: ca.Function | None = None
-        hyb = dae.hybrid
+        hyb = dae.hybrid or HybridPart()
         nb = dae.n_base
         self.sample_slots = [nb + s.slot for s in hyb.samples]
         fp = ca.Function("sample_times", [dae.p], [ca.vertcat(
@@ -97,11 +125,15 @@ class HybridSimulator:
         self.recent: deque[tuple[float, str]] = deque(maxlen=self.opts.zeno_events)
 
     # -- public -----------------------------------------------------------------------------
-    def run(self, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray, str | None]:
+    def run(self, grid: np.ndarray, progress=None) -> tuple[np.ndarray, np.ndarray, str | None]:
         """Simulate over ``grid`` (output points); returns times, rows (observed ``obs_idx``)
-        and a solver failure message (None on success)."""
+        and a solver failure message (None on success). ``progress(fraction)`` is called
+        now and then."""
         t = float(grid[0])
         x, z = self._initialize(t)
+        if self.selection is not None:
+            x, z = self._initial_selection(t, x, z)
+        next_report = 0.05
         times: list[float] = [t]
         rows: list[np.ndarray] = [self._obs(t, x, z)]
 
@@ -114,11 +146,14 @@ class HybridSimulator:
         failure = None
         while t < stop:
             t_event, kind = self._next_time_event(t, stop)
+            t_end = t_event
+            if self.selection is not None:       # short stretches: a failure costs little
+                t_end = min(t_event, t + self.selection.stretch)
             j = k_out
-            while j < len(grid) and grid[j] < t_event:
+            while j < len(grid) and grid[j] < t_end:
                 j += 1
             try:
-                t, x, z, crossed, passed = self._advance(t, t_event, x, z, grid[k_out:j])
+                t, x, z, crossed, passed = self._advance(t, t_end, x, z, grid[k_out:j])
             except RuntimeError as err:
                 failure = str(err)
                 break
@@ -126,7 +161,13 @@ class HybridSimulator:
                 times.append(t_k)
                 rows.append(row)
                 k_out += 1
-            if crossed is None and kind is not None:
+            if progress is not None and (t - grid[0]) >= next_report * (stop - grid[0]):
+                progress(min(1.0, (t - grid[0]) / (stop - grid[0])))
+                next_report += 0.05
+            if crossed == "select":
+                x, z = self._switch(t, x, z)
+                continue
+            if crossed is None and kind is not None and t == t_event:
                 crossed = kind
             if crossed is not None:
                 x, z, left, right = self._event(t, x, z, crossed)
@@ -137,6 +178,11 @@ class HybridSimulator:
             elif t >= stop:
                 record()
                 k_out = len(grid)
+            elif k_out < len(grid) and grid[k_out] == t:
+                record()
+                k_out += 1
+        if progress is not None and failure is None:
+            progress(1.0)
         if failure is None and self.dae.hybrid.terminal >= 0:
             x, z, left, right = self._event(t, x, z, "terminal")
             times += [t, t]
@@ -157,35 +203,34 @@ class HybridSimulator:
         fn = self.fn
         if t1 <= t0:
             return t0, x, z, None, []
-        if self.dae.x.numel() == 0:
-            if fn.state_rel:
-                raise EventError("a model without states cannot have state events yet; "
-                                 "write the switching condition on time or a state", t0)
-            passed = [(float(tk), self._obs(float(tk), x, self._solve_z(float(tk), x)))
-                      for tk in outs]
-            return t1, x, self._solve_z(t1, x), None, passed
-        if not fn.state_rel and len(outs) == 0:
+        sel = self.selection
+        outs = np.asarray(outs, dtype=float)
+        if not fn.state_rel and len(outs) == 0 and sel is None:
             xf, zf = self._integrate_one(t0, t1, x, z)
             return t1, xf, zf, None, []
         checks = self.opts.checks if fn.state_rel else 1
-        offsets = np.union1d(np.asarray(outs, dtype=float) - t0,
-                             (t1 - t0) * np.arange(1, checks + 1) / checks)
+        if sel is not None:
+            checks = max(checks, int(math.ceil((t1 - t0) / sel.spacing)))
+        out_offsets = outs - t0
+        uniform = (t1 - t0) * np.arange(1, checks + 1) / checks
+        offsets = np.union1d(out_offsets, uniform)
         offsets = offsets[offsets > 0]
-        F = self._shifted(tuple(offsets))
-        res = F(x, z, np.concatenate([self.p, [t0]]))
-        self.n_segments += 1
-        n_t = len(offsets)
-        X = res[0].reshape(n_t, len(x)).T.copy()
+        try:
+            X, Z = self._columns(t0, x, z, offsets)
+        except RuntimeError:
+            # with dynamic state selection the current choice may fail before the next pivot
+            # check: integrate a shorter stretch, whose checks switch the states in time
+            if sel is None or t1 - t0 < 1e-12 * max(1.0, abs(t0)):
+                raise
+            t_short = t0 + 0.25 * (t1 - t0)
+            return self._advance(t0, t_short, x, z, outs[outs < t_short])
         nz = self.dae.z.numel()
-        Z = res[1].reshape(n_t, nz).T.copy() if nz else np.zeros((0, n_t))
         ts = t0 + offsets
         ts[-1] = t1
-        out_set = set(np.asarray(outs, dtype=float).tolist())
-        last = X.shape[1]
+        last = len(offsets)
         crossing = None
         if fn.state_rel:
-            m = X.shape[1]
-            G = np.asarray(self._ind_map(m)(ts.reshape(1, -1), X, Z, self.p))
+            G = np.asarray(self._ind_map(last)(ts.reshape(1, -1), X, Z, self.p))
             frozen = self.p[fn.rel_slot[fn.state_rel]].astype(bool)
             now = self._values(G, fn.strict[fn.state_rel])
             cols = np.nonzero((now != frozen[:, None]).any(axis=0))[0]
@@ -197,18 +242,114 @@ class HybridSimulator:
                 g_lo = self._ind(*lo) if j == 0 else G[:, j - 1]
                 crossing = self._locate(lo[0], lo[1], lo[2], g_lo, float(ts[j]), X[:, j],
                                         Z[:, j] if nz else z, G[:, j], frozen)
+        if sel is not None:
+            cols = np.searchsorted(offsets, uniform)
+            stop_col = self._selection_column(ts, X, Z, z, cols[cols < last])
+            if stop_col is not None:
+                crossing = (float(ts[stop_col]), X[:, stop_col],
+                            Z[:, stop_col] if nz else z, "select")
+                last = stop_col + 1
         passed = []
-        for c in range(last):
-            if float(t0 + offsets[c]) in out_set:
-                tk = float(t0 + offsets[c])
+        out_cols = np.searchsorted(offsets, out_offsets)
+        for k, c in enumerate(out_cols):
+            if c < last and out_offsets[k] > 0:
+                tk = float(outs[k])
                 passed.append((tk, self._obs(tk, X[:, c], Z[:, c] if nz else z)))
         if crossing is not None:
             return (*crossing[:3], crossing[3], passed)
         return t1, X[:, -1], Z[:, -1] if nz else z, None, passed
 
+    def _columns(self, t0: float, x, z, offsets: np.ndarray):
+        """States and algebraic variables at ``t0 + offsets`` (one integrator call, or
+        algebraic solves for a model without states)."""
+        nz = self.dae.z.numel()
+        n_t = len(offsets)
+        if len(x) == 0:
+            Z = np.zeros((nz, n_t))
+            for c, off in enumerate(offsets):
+                Z[:, c] = self._solve_z(t0 + float(off), x)
+            return np.zeros((0, n_t)), Z
+        F = self._shifted(tuple(offsets))
+        res = F(x, z, np.concatenate([self.p, [t0]]))
+        self.n_segments += 1
+        X = res[0].reshape(n_t, len(x)).T.copy()
+        Z = res[1].reshape(n_t, nz).T.copy() if nz else np.zeros((0, n_t))
+        return X, Z
+
+    # -- dynamic state selection ------------------------------------------------------------
+    def _selection_column(self, ts, X, Z, z, cols) -> int | None:
+        """First pivot-check column among ``cols`` where the state choice must change."""
+        sel = self.selection
+        nz = self.dae.z.numel()
+        nv = self.dae.n_variables
+        for c in cols:
+            t = float(ts[c])
+            values = self._step_fast(t, X[:, c], Z[:, c] if nz else z, self.p)[6][:nv]
+            if sel.mode == "check":
+                now, best, _, _ = sel.selector.assess(sel.current, values, self.p, t)
+                if not now >= sel.fail_ratio * best:
+                    raise SimulationError(
+                        f"the state choice ({', '.join(self.dae.state_names)}) degenerates at "
+                        f"t = {t:.6g} s (pivot {now:.2g}, best {best:.2g}): with dynamic=False "
+                        "the states cannot change; simulate with dynamic=True (the default) or "
+                        "choose other states with state_select", t)
+                continue
+            nxt = sel.selector.check(sel.current, values, self.p, t)
+            if nxt is not sel.current:
+                self._pending = nxt
+                return c
+        return None
+
+    def _initial_selection(self, t: float, x, z):
+        sel = self.selection
+        nv = self.dae.n_variables
+        values = self._step_fast(t, x, z, self.p)[6][:nv].copy()
+        bad = ~np.isfinite(values)
+        if bad.any():
+            starts = [float(getattr(v.decl, "start", 0.0))
+                      for v in sel.current.reduced.model.variables]
+            values[bad] = np.asarray(starts)[bad]
+        if sel.mode == "check":
+            return x, z
+        nxt = sel.selector.check(sel.current, values, self.p, t)
+        if nxt is sel.current:
+            return x, z
+        self._use_variant(nxt)
+        x, z = self._consistent(t, None)
+        return x, z
+
+    def _use_variant(self, compiled) -> None:
+        sel = self.selection
+        dae = compiled.dae
+        if sel.prepare is not None:
+            dae = sel.prepare(dae)
+        if dae.hybrid is None:
+            dae = replace(dae, hybrid=HybridPart())
+        sel.current = compiled
+        self.dae = dae
+        self.fn = build(dae)
+        self._step_fast = Fast(self.fn.step)
+        self._ind_fast = Fast(self.fn.indicators)
+        self._one = None
+        self._z_guess = None
+
+    def _switch(self, t: float, x, z):
+        """Continue with the variant chosen by the pivot test, from the current values."""
+        old = self.dae
+        values = self._step_fast(t, x, z, self.p)[6].copy()
+        self._use_variant(self._pending)
+        idx = old.observed_index
+        x_new = np.array([values[idx[n]] for n in self.dae.state_names])
+        self._z_guess = np.array([values[idx[n]] for n in self.dae.algebraic_names])
+        z_new = self._solve_z(t, x_new) if self.fn.alg_solver is not None else np.zeros(0)
+        self.log.causes["state selection"] = self.log.causes.get("state selection", 0) + 1
+        return x_new, z_new
+
     def _shifted(self, offsets: tuple[float, ...]) -> Fast:
         """An integrator from t0 (a parameter) to ``t0 + offsets`` (cached)."""
         cache = self.dae.cache.setdefault(("shifted", self._opts_key), {})
+        if len(offsets) > 64:                       # long runs: not worth keeping
+            return Fast(_integrator(self.dae, self._sol_opts, list(offsets), scaled=False))
         F = cache.get(offsets)
         if F is None:
             if len(cache) > 64:
@@ -257,6 +398,8 @@ class HybridSimulator:
         return hi_t, hi_x, hi_z, f"state:{cause}"
 
     def _integrate_one(self, t0, t1, x, z):
+        if len(x) == 0:
+            return x, self._solve_z(t1, x)
         if self._one is None:
             self._one = Fast(_integrator(self.dae, self._sol_opts, [1.0], scaled=True))
             self._pe = np.zeros(len(self.p) + 2)
@@ -289,8 +432,6 @@ class HybridSimulator:
                 best, kind = ts, "sample"
         for table, _, _ in self.tables:
             ts = table_coefficients(table, t)[2]
-            if ts <= t:
-                ts = table_coefficients(table, math.nextafter(ts, math.inf))[2]
             if ts < best:
                 best, kind = ts, "table"
         if self._time_next < best:
@@ -521,7 +662,7 @@ def _integrator(dae: CasadiDAE, opts: dict, tout: list[float], scaled: bool) -> 
     problem = {"x": x, "p": ca.vertcat(dae.p, t0, dt) if scaled else ca.vertcat(dae.p, t0),
                "t": tau, "ode": scale * ca.substitute(ode, dae.t, t_of)}
     solver = "cvodes"
-    solver_opts = dict(opts)
+    solver_opts = dict(opts, disable_internal_warnings=True, show_eval_warnings=False)
     if dae.z.numel():
         problem.update(z=dae.z, alg=ca.substitute(dae.alg, dae.t, t_of))
         solver = "idas"

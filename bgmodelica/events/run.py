@@ -11,20 +11,29 @@ from ..backends.casadi_dae import CasadiDAE
 from ..errors import SimulationError
 from ..result import Result
 from .inputs import with_input_tables
-from .loop import HybridSimulator
+from .loop import HybridSimulator, Selection
 
 
 def simulate_hybrid(compiled, dae: CasadiDAE, p: np.ndarray, grid: np.ndarray, *, rtol: float,
                     atol: float, max_step: float | None, max_steps: int, outputs, inputs: Any,
-                    t_start: float) -> Result:
-    """Simulate a model with events (or time-varying inputs) over the output ``grid``."""
+                    t_start: float, selection: Selection | None = None,
+                    progress=None) -> Result:
+    """Simulate a model with events, time-varying inputs or dynamic state selection over the
+    output ``grid``."""
     if inputs is not None:
         n_before = len(dae.discretes)
         dae = with_input_tables(dae, inputs)
         p = np.concatenate([p, np.zeros(len(dae.discretes) - n_before)])
     obs_idx = _output_indices(dae, outputs)
-    sim = HybridSimulator(dae, p, rtol, atol, max_step, max_steps, obs_idx)
-    times, rows, failure = sim.run(grid)
+    if selection is not None:
+        selection.selector.switches.clear()
+    if selection is not None and inputs is not None:
+        prepare = selection.prepare
+        selection.prepare = lambda d: with_input_tables(prepare(d) if prepare else d, inputs)
+    sim = HybridSimulator(dae, p, rtol, atol, max_step, max_steps, obs_idx,
+                          selection=selection)
+    times, rows, failure = sim.run(grid, progress)
+    dae = sim.dae
     names = [dae.names[k] for k in obs_idx]
     kept = set(names)
     aliases = {a: rep for a, rep in dae.aliases.items() if rep[0] in kept}
@@ -37,6 +46,9 @@ def simulate_hybrid(compiled, dae: CasadiDAE, p: np.ndarray, grid: np.ndarray, *
             "timings": dict(compiled.timings), "solver": "cvodes" if not dae.z.numel()
             else "idas", "stats": dict(sim.stats), "states": list(dae.state_names),
             "init_notes": [], **sim.meta}
+    if selection is not None and selection.mode == "switch":
+        meta["state_switches"] = list(selection.selector.switches)
+        meta["states"] = list(dae.state_names)
     values = rows if len(rows) else np.zeros((0, len(names)))
     result = Result(times, values, names, aliases, params_out, units, meta)
     if failure is not None:

@@ -34,21 +34,22 @@ def is_sample_instant(start: float, interval: float, t: float) -> bool:
 
 def table_coefficients(table: FlatTable, t: float) -> tuple[float, float, float]:
     """``(c0, c1, next breakpoint)``: the table equals ``c0 + c1*time`` from ``t`` (right
-    limit) up to the next breakpoint strictly after ``t`` (inf if none)."""
+    limit) up to the next breakpoint after ``t`` (inf if none).
+
+    A time within a few ulps of a breakpoint counts as the breakpoint itself: event times
+    of periodic tables (``breakpoint + n*period``) are computed in floating point."""
     times = np.asarray(table.times)
     values = np.asarray(table.values)
     t0, t1 = float(times[0]), float(times[-1])
+    eps = 1e-12 * max(1.0, abs(t), abs(t1 - t0))
     shift = 0.0
     local = t
-    if table.extrapolation == "periodic" and (t < t0 or t >= t1):
+    if table.extrapolation == "periodic" and (t < t0 - eps or t >= t1 - eps):
         period = t1 - t0
-        n = math.floor((t - t0) / period)
+        n = math.floor((t - t0) / period + eps / period)
         shift = n * period
         local = t - shift
-        if local >= t1:           # rounding at the period boundary
-            shift += period
-            local -= period
-    i = int(np.searchsorted(times, local, side="right"))      # times[i-1] <= local < times[i]
+    i = int(np.searchsorted(times, local + eps, side="right"))   # times[i-1] <= local
     n_pts = len(times)
     if i == 0:                                                 # before the table
         nxt = t0 + shift

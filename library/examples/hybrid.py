@@ -16,6 +16,7 @@ from bgmodelica import (
     Parameter,
     StateSelect,
     Variable,
+    connect,
     der,
     eq,
     fabs,
@@ -28,8 +29,9 @@ from bgmodelica import (
     time,
     when,
 )
+from library.electrical import Capacitor, Ground, IdealDiode, Resistor, SineVoltage
 
-__all__ = ["BouncingBall", "StickSlip", "PWMMotor", "PendulumWall"]
+__all__ = ["BouncingBall", "StickSlip", "PWMMotor", "PendulumWall", "HalfWaveRectifier"]
 
 
 class BouncingBall(Component):
@@ -169,3 +171,46 @@ class PendulumWall(Component):
         yield when(self.x < self.x_wall,
                    reinit(self.vx, -self.e * pre(self.vx)),
                    reinit(self.vy, -self.e * pre(self.vy)))
+
+
+class HalfWaveRectifier(Component):
+    """A half-wave rectifier: a sine source feeds an RC load through an ideal diode.
+
+    source (v = V sin(2 pi f t)) -> diode (IdealDiode: Ron, Goff, Vknee = 0; anode at the
+    source) -> load: resistor R in parallel with capacitor C -> ground. The diode conducts
+    (``diode.off`` false) while it carries forward current and blocks once the current would
+    turn negative; it turns on again when the source rises above the load voltage. Both are
+    state events of the relation ``diode.s < 0``: two switchings per period (the first half
+    period starts conducting from v_out = 0).
+
+    Parameters: V [V] (amplitude), f [Hz], Ron [Ohm], Goff [S], R [Ohm], C [F].
+    Variables: v_out [V] (load voltage, v_out(0) = 0), i_d [A] (diode current, anode ->
+    cathode). Subcomponents: source, diode, resistor, capacitor, ground. State: capacitor.v.
+    """
+
+    V = Parameter(10.0, unit="V", description="Source amplitude")
+    f = Parameter(50.0, unit="Hz", description="Source frequency")
+    Ron = Parameter(1e-5, unit="Ohm", description="Diode on resistance")
+    Goff = Parameter(1e-5, unit="S", description="Diode off conductance")
+    R = Parameter(100.0, unit="Ohm", description="Load resistance")
+    C = Parameter(100e-6, unit="F", description="Load (smoothing) capacitance")
+    v_out = Variable(unit="V", start=0.0, fixed=True, description="Load voltage")
+    i_d = Variable(unit="A", description="Diode current (anode -> cathode)")
+
+    def __init__(self, **modifiers):
+        super().__init__(**modifiers)
+        self.source = SineVoltage(V=self.V, f=self.f)
+        self.diode = IdealDiode(Ron=self.Ron, Goff=self.Goff)
+        self.resistor = Resistor(R=self.R)
+        self.capacitor = Capacitor(C=self.C)
+        self.ground = Ground()
+
+    def equations(self):
+        yield connect(self.source.p, self.diode.p)
+        yield connect(self.diode.n, self.resistor.p)
+        yield connect(self.diode.n, self.capacitor.p)
+        yield connect(self.resistor.n, self.ground.p)
+        yield connect(self.capacitor.n, self.ground.p)
+        yield connect(self.source.n, self.ground.p)
+        yield self.v_out == self.capacitor.v
+        yield self.i_d == self.diode.i
