@@ -366,7 +366,8 @@ class HybridSimulator:
         g_lo = np.array(g_lo, dtype=float)
         g_hi = np.array(g_hi, dtype=float)
         side = 0
-        for _ in range(200):
+        widths = [hi_t - lo_t]
+        for _ in range(400):
             if hi_t - lo_t <= tol:
                 break
             changed = self._values(g_hi[:, None], strict)[:, 0] != frozen
@@ -378,7 +379,9 @@ class HybridSimulator:
                     cand = min(cand, tc)
             margin = 0.1 * tol
             cand = min(max(cand, lo_t + margin), hi_t - margin)
-            if not (lo_t < cand < hi_t):
+            # safeguard: bisect when the bracket did not halve over the last three steps
+            # (an indicator that is exactly 0 at lo_t stalls the secant at lo_t)
+            if not (lo_t < cand < hi_t) or (len(widths) > 3 and widths[-1] > 0.5 * widths[-4]):
                 cand = 0.5 * (lo_t + hi_t)
             xc, zc = self._integrate_one(lo_t, cand, lo_x, lo_z)
             gc = self._ind(cand, xc, zc)
@@ -392,6 +395,7 @@ class HybridSimulator:
                 if side == -1:
                     g_hi = g_hi * 0.5
                 side = -1
+            widths.append(hi_t - lo_t)
         changed = self._values(g_hi[:, None], strict)[:, 0] != frozen
         cause = " and ".join(self.fn.relations[fn.state_rel[k]].text
                              for k in np.nonzero(changed)[0][:3])

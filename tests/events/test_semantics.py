@@ -69,7 +69,7 @@ def test_sample_counter_and_event_rows():
 class Thermostat(Component):
     """Relay with hysteresis on a first-order room: heat on below 19, off above 21."""
 
-    T = Variable(unit="K", start=20.0, fixed=True)
+    T = Variable(start=20.0, fixed=True)
     heating = Boolean(start=True)
 
     def equations(self):
