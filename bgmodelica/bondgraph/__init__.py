@@ -1,13 +1,23 @@
 """Bond graphs as first-class models.
 
 Elements (:mod:`.elements`): ``Se, Sf, R, C, I, TF, GY, MTF, MGY, ZeroJunction (J0),
-OneJunction (J1), De, Df, Dq`` with :class:`PowerPort` s; :class:`BondGraph` components with
+OneJunction (J1), De, Df, Dq, Sw`` (Sw: switch of hybrid bond graphs) with
+:class:`PowerPort` s; :class:`BondGraph` components with
 ``bond(a, b)`` and ``expose(name, target)``; the pure :class:`Graph` (``graph_of``);
 causality (SCAP, BGI/BGD views), structural controllability/observability, causal equations
 (text, LaTeX), ``analyze(model) -> BondGraphReport`` and ``draw(model, path)``.
 """
 
-from .causality import BGD, BGI, Causality, Conflict, assign_causality, signal_graph
+from .causality import (
+    BGD,
+    BGI,
+    Causality,
+    Conflict,
+    IdealMode,
+    assign_causality,
+    ideal_modes,
+    signal_graph,
+)
 from .draw import draw, layout
 from .elements import (
     GY,
@@ -27,6 +37,7 @@ from .elements import (
     R,
     Se,
     Sf,
+    Sw,
     ZeroJunction,
     bond_flow,
     orientation,
@@ -46,9 +57,11 @@ from .structural import StructuralProperty, controllability, observability
 
 __all__ = [
     "PowerPort", "BGElement", "Se", "Sf", "R", "C", "I", "TF", "GY", "MTF", "MGY",
-    "ZeroJunction", "OneJunction", "J0", "J1", "De", "Df", "Dq", "orientation", "bond_flow",
+    "ZeroJunction", "OneJunction", "J0", "J1", "De", "Df", "Dq", "Sw", "orientation",
+    "bond_flow",
     "BondGraph", "graph_of", "Graph", "Node", "Bond",
     "assign_causality", "Causality", "Conflict", "BGI", "BGD", "signal_graph",
+    "ideal_modes", "IdealMode",
     "controllability", "observability", "StructuralProperty",
     "causal_equations", "CausalEquations",
     "analyze", "BondGraphReport", "draw", "layout",

@@ -238,6 +238,10 @@ class BGElement(Component):
     def modulus_text(self) -> str:
         return ""
 
+    def mode_text(self) -> str:
+        """Text of the Boolean mode of a switched element (empty for the others)."""
+        return ""
+
     def power_ports(self) -> list[PowerPort]:
         return [p for p in self._children.values() if isinstance(p, PowerPort)]
 

@@ -9,6 +9,12 @@ is drawn). Constraints:
 * C: integral causality = flow in, effort out (stroke away); derivative = stroke at C.
   I: integral causality = effort in, flow out (stroke at I); derivative = stroke away.
 * R, X (adapters to other domains): free.
+* Sw (switch of a hybrid bond graph): free, like an R, and *fixed across modes*. The element
+  is written in the resistive form e = s*(Ron if on else 1), f = s*(1 if on else Goff)
+  (Modelica's ideal switch), whose structure does not depend on the mode, so one causality
+  serves both modes and no reassignment happens at a switching event. (The ideal modes, an
+  Se of value 0 when on and an Sf of value 0 when off, are checked separately by
+  :func:`ideal_modes`.)
 * 0-junction: exactly one bond imposes the (common) effort on the junction.
   1-junction: exactly one bond imposes the (common) flow on the junction.
 * TF/MTF: effort passes through (exactly one stroke at the element);
@@ -17,8 +23,9 @@ is drawn). Constraints:
 SCAP: (1) fixed-causality elements (sources, detectors), propagate; (2) storage elements one by
 one (higher ``priority`` first, then declaration order) in preferred causality (integral for
 the BGI, derivative for the BGD), propagate; an element whose bond was already fixed by an
-earlier propagation is *forced* into that causality; (3) free elements (R, X) in resistance
-causality, propagate; (4) any bond still open (a loop of the junction structure) arbitrarily.
+earlier propagation is *forced* into that causality; (3) free elements (R, X, Sw) in
+resistance causality, propagate; (4) any bond still open (a loop of the junction structure)
+arbitrarily.
 Each choice is tentative: if its propagation runs into a contradiction it is undone and the
 alternative tried; if both fail, a :class:`Conflict` is recorded.
 
@@ -31,7 +38,17 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass, field
 
-from .graph import DETECTORS, JUNCTIONS, SOURCES, STORAGE, TWO_PORTS, Bond, Graph, Node
+from .graph import (
+    DETECTORS,
+    JUNCTIONS,
+    SOURCES,
+    STORAGE,
+    SWITCHES,
+    TWO_PORTS,
+    Bond,
+    Graph,
+    Node,
+)
 
 BGI = "BGI"
 BGD = "BGD"
@@ -59,6 +76,8 @@ class Causality:
     forced: storage elements that could not get the view's preferred causality (in the BGI:
     those forced into derivative causality by sources or other storage elements).
     resistors: R / X element -> "resistance" (flow in) / "conductance" (effort in).
+    switches: Sw element -> "resistance" / "conductance": the causality of its resistive form,
+    the same in every mode (not listed in ``arbitrary``).
     arbitrary: elements or bonds ("bond 7") that needed an arbitrary choice.
     conflicts: unresolvable contradictions. loops: zero-order causal paths, each a dict with
     the bonds and elements on it.
@@ -70,6 +89,7 @@ class Causality:
     storage: dict[str, str] = field(default_factory=dict)
     forced: list[str] = field(default_factory=list)
     resistors: dict[str, str] = field(default_factory=dict)
+    switches: dict[str, str] = field(default_factory=dict)
     arbitrary: list[str] = field(default_factory=list)
     conflicts: list[Conflict] = field(default_factory=list)
     loops: list[dict] = field(default_factory=list)
@@ -91,7 +111,8 @@ class Causality:
             "bonds": [{"bond": b.number, "from": b.tail, "to": b.head,
                        "stroke_at": self.effort_to.get(b.number)} for b in self.graph.bonds],
             "integral": self.integral, "derivative": self.derivative, "forced": self.forced,
-            "resistors": dict(self.resistors), "arbitrary": list(self.arbitrary),
+            "resistors": dict(self.resistors), "switches": dict(self.switches),
+            "arbitrary": list(self.arbitrary),
             "conflicts": [c.to_dict() for c in self.conflicts],
             "zero_order_causal_paths": self.loops,
         }
@@ -116,7 +137,7 @@ def _wanted(node: Node, choice: str) -> str:
         return "other" if choice == "integral" else "self"
     if k == "I":
         return "self" if choice == "integral" else "other"
-    # R, X, and dualized sources/detectors: "resistance" = flow in, effort out
+    # R, X, Sw and dualized sources/detectors: "resistance" = flow in, effort out
     return "other" if choice in ("resistance", "effort-out") else "self"
 
 
@@ -230,7 +251,7 @@ def assign_causality(graph: Graph, view: str = BGI, dualize: frozenset[str] | se
         return n.kind in dualize and n.name not in kept
 
     fixed = [n for n in order if (n.kind in SOURCES | DETECTORS) and not dual(n)]
-    free = [n for n in order if n.kind in ("R", "X") or dual(n)]
+    free = [n for n in order if n.kind in ("R", "X") or n.kind in SWITCHES or dual(n)]
     storage = sorted((n for n in order if n.kind in STORAGE),
                      key=lambda n: -n.priority)          # stable: declaration order kept
     preferred = "integral" if view == BGI else "derivative"
@@ -271,7 +292,8 @@ def assign_causality(graph: Graph, view: str = BGI, dualize: frozenset[str] | se
     for n in free:
         if not inc[n.name] or assigned(n):
             continue
-        res.arbitrary.append(n.name)
+        if n.kind not in SWITCHES:
+            res.arbitrary.append(n.name)
         err = a.attempt(lambda n=n: a.one_port(n, _wanted(n, "resistance")))
         if err is not None:
             err2 = a.attempt(lambda n=n: a.one_port(n, _wanted(n, "conductance")))
@@ -302,6 +324,8 @@ def assign_causality(graph: Graph, view: str = BGI, dualize: frozenset[str] | se
         if n.kind in STORAGE:
             integral = into if n.kind == "I" else not into
             res.storage[n.name] = "integral" if integral else "derivative"
+        elif n.kind in SWITCHES:
+            res.switches[n.name] = "conductance" if into else "resistance"
         elif n.kind in ("R", "X") or dual(n):
             res.resistors[n.name] = "conductance" if into else "resistance"
         elif n.kind in SOURCES | DETECTORS:
@@ -315,6 +339,61 @@ def assign_causality(graph: Graph, view: str = BGI, dualize: frozenset[str] | se
     res.forced = [n.name for n in storage if res.storage.get(n.name, preferred) != preferred]
     res.loops = zero_order_paths(res)
     return res
+
+
+# -- switches: the ideal modes -------------------------------------------------------------
+@dataclass
+class IdealMode:
+    """Causality of the graph with one switch in an *ideal* mode: ``on`` as a zero effort
+    source (Se of value 0), ``off`` as a zero flow source (Sf of value 0), the other switches
+    staying in their resistive form.
+
+    forced: storage elements in integral causality with the resistive form that the ideal
+    mode puts in derivative causality: with the resistive form they keep their state but get
+    a fast time constant set by ``Ron`` / ``Goff`` (an inductance in series with an open
+    switch, a capacitance shorted by a closed one). conflicts: causal conflicts of the ideal
+    mode (e.g. a closed switch in parallel with an effort source): the resistive form makes
+    them well-posed but stiff or with large currents.
+    """
+
+    switch: str
+    mode: str
+    states: int
+    forced: list[str] = field(default_factory=list)
+    conflicts: list[Conflict] = field(default_factory=list)
+
+    @property
+    def consistent(self) -> bool:
+        return not self.forced and not self.conflicts
+
+    def to_dict(self) -> dict:
+        return {"switch": self.switch, "mode": self.mode, "states": self.states,
+                "forced_derivative": list(self.forced),
+                "conflicts": [c.to_dict() for c in self.conflicts]}
+
+
+def ideal_modes(graph: Graph, bgi: Causality | None = None) -> list[IdealMode]:
+    """For each switch (``Sw``) of ``graph`` and each of its modes, SCAP (BGI) with the switch
+    replaced by its ideal element (on: Se of value 0, off: Sf of value 0). Compared with the
+    resistive-form causality ``bgi``: which storage elements the ideal mode would force into
+    derivative causality (a change of causality and of the number of states, which the
+    resistive form avoids)."""
+    from dataclasses import replace
+
+    switches = [n for n in graph.nodes.values() if n.kind in SWITCHES]
+    if not switches:
+        return []
+    bgi = bgi or assign_causality(graph, BGI, check=False)
+    out = []
+    for sw in switches:
+        for mode, kind in (("on", "Se"), ("off", "Sf")):
+            g = Graph(graph.name, {k: (replace(v, kind=kind, zero=True, label="0")
+                                       if k == sw.name else v)
+                                   for k, v in graph.nodes.items()}, list(graph.bonds))
+            c = assign_causality(g, BGI, check=False)
+            forced = [x for x in bgi.integral if c.storage.get(x) != "integral"]
+            out.append(IdealMode(sw.name, mode, len(c.integral), forced, list(c.conflicts)))
+    return out
 
 
 # -- signal-flow graph ---------------------------------------------------------------------
@@ -394,7 +473,7 @@ def signal_graph(c: Causality) -> SignalGraph:
             add(("e", k), ("y", name), True, name)
         elif n.kind == "Df":
             add(("f", k), ("y", name), True, name)
-        elif n.kind == "R":
+        elif n.kind == "R" or n.kind in SWITCHES:
             if into:
                 add(("e", k), ("f", k), True, name)
             else:
@@ -463,7 +542,7 @@ def _sccs(succ: dict[tuple, list[tuple]]) -> list[list[tuple]]:
 def zero_order_paths(c: Causality) -> list[dict]:
     """Algebraic loops of the causal graph: strongly connected sets of effort/flow signals
     linked by algebraic (non-integrating) relations. Each: ``{"bonds": [...], "elements":
-    [...], "resistors": [...]}``."""
+    [...], "resistors": [...]}`` (resistors: the R and Sw elements on the loop)."""
     sg = signal_graph(c)
     comps = [comp for comp in _sccs(sg.successors(algebraic_only=True)) if len(comp) > 1]
     out = []
@@ -474,7 +553,7 @@ def zero_order_paths(c: Causality) -> list[dict]:
         for s, d, alg, el in sg.edges:
             if alg and s in members and d in members and el not in elements:
                 elements.append(el)
-        resistors = [e for e in elements if c.graph.nodes[e].kind == "R"]
+        resistors = [e for e in elements if c.graph.nodes[e].kind in ("R", *SWITCHES)]
         out.append({"bonds": bonds, "elements": elements, "resistors": resistors})
     return out
 

@@ -5,7 +5,7 @@
 the elements' ``pos`` hints (``BondGraph.add(name, elem, at=(x, y))``, offsets of nested
 subsystems added); elements without a hint are placed by a small force-directed layout.
 Storage elements in derivative causality are drawn in red, sources in blue, detectors in
-green; bonds of a causal conflict in red.
+green, switches (Sw) in purple; bonds of a causal conflict in red.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from .causality import BGI, Causality, assign_causality
-from .graph import DETECTORS, JUNCTIONS, SOURCES, Graph
+from .graph import DETECTORS, JUNCTIONS, SOURCES, SWITCHES, Graph
 from .report import as_graph
 
 __all__ = ["draw", "layout"]
@@ -147,6 +147,8 @@ def draw(model: Any, path: str | Path, *, view: str = BGI, causality: Causality 
             color = "#1f4fbf"
         elif node.kind in DETECTORS:
             color = "#1a7f37"
+        elif node.kind in SWITCHES:
+            color = "#7b2fbe"
         if n in derivative or n in conflict_nodes:
             color = "#c00000"
         weight = "bold" if node.kind in JUNCTIONS else "normal"

@@ -5,7 +5,8 @@ substitution along the causal paths, the state equations.
 Notation: bond ``k`` carries effort ``e_k`` and flow ``f_k`` (along its half-arrow); an I
 element on bond k has momentum ``p_k`` (``dp_k/dt = e_k``), a C element displacement ``q_k``
 (``dq_k/dt = f_k``). A modulus is written with the element's label (``k2``, ``r1``); the
-definitions of modulated moduli are listed separately.
+definitions of modulated moduli are listed separately. A switch ``Sw`` appears as a resistor
+of modulus ``Ron if on else 1/Goff`` (its resistive form, the same causality in both modes).
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from .causality import Causality
-from .graph import JUNCTIONS, Graph
+from .graph import JUNCTIONS, SWITCHES, Graph
 
 
 # -- a tiny expression tree, printable as text or LaTeX -----------------------------------
@@ -350,7 +351,10 @@ def causal_equations(c: Causality) -> CausalEquations:
         elif n.kind == "Df":
             out.elements.append(CausalEquation(name, title, e(k), Sym("0", "0")))
             define[("e", k)] = Sym("0", "0")
-        elif n.kind == "R":
+        elif n.kind == "R" or n.kind in SWITCHES:
+            if n.kind in SWITCHES:       # resistive form: e = (Ron if on else 1/Goff)*f
+                out.moduli[n.symbol] = ("Ron if on else 1/Goff (resistive switch), on: "
+                                        + (n.mode or "?"))
             if into:
                 rhs = Quot(e(k), m)
                 out.elements.append(CausalEquation(name, title, f(k), rhs))

@@ -25,11 +25,14 @@ SOURCES = {"Se", "Sf"}
 DETECTORS = {"De", "Df"}
 STORAGE = {"C", "I"}
 RESISTORS = {"R"}
+#: switched one-ports of hybrid bond graphs (Mosterman & Biswas): free causality, kept fixed
+#: across modes (resistive form e = s*(Ron if on else 1), f = s*(1 if on else Goff))
+SWITCHES = {"Sw"}
 TWO_PORTS = {"TF", "GY", "MTF", "MGY"}
 JUNCTIONS = {"0", "1"}
 EXTERNAL = {"X"}          # adapter to another physical domain's connector: free causality
-KINDS = SOURCES | DETECTORS | STORAGE | RESISTORS | TWO_PORTS | JUNCTIONS | EXTERNAL
-ONE_PORTS = SOURCES | DETECTORS | STORAGE | RESISTORS | EXTERNAL
+KINDS = SOURCES | DETECTORS | STORAGE | RESISTORS | TWO_PORTS | JUNCTIONS | EXTERNAL | SWITCHES
+ONE_PORTS = SOURCES | DETECTORS | STORAGE | RESISTORS | EXTERNAL | SWITCHES
 
 
 @dataclass
@@ -40,7 +43,8 @@ class Node:
     drawing ("L" -> ``I:L``) and the symbol of its modulus/parameter in equations.
     modulus: text of a (modulated) modulus, e.g. ``-lc1*sin(q1)``. priority: storage elements
     of higher priority get integral causality first. zero: a source of value 0 (an open port
-    of a subsystem), not counted as an input. pos: drawing position hint.
+    of a subsystem), not counted as an input. pos: drawing position hint. mode: for a switch
+    (``Sw``), the text of its Boolean mode (``time >= t_s``, ``drive``, ``sw.u > 0.5``).
     """
 
     name: str
@@ -51,6 +55,7 @@ class Node:
     zero: bool = False
     pos: tuple[float, float] | None = None
     ports: list[str] = field(default_factory=list)
+    mode: str = ""
 
     @property
     def title(self) -> str:

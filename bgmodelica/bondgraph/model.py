@@ -237,6 +237,7 @@ def graph_of(model: Component, name: str | None = None) -> Graph:
             ports = elem.power_ports()
             graph.add(path, elem.kind, label=elem.label(), modulus=elem.modulus_text(),
                       priority=elem._priority, ports=[p.name for p in ports],
+                      mode=elem.mode_text(),
                       pos=(offset[0] + pos[0], offset[1] + pos[1]) if pos is not None
                       else None)
             for p in ports:

@@ -1,14 +1,19 @@
 """``analyze(model) -> BondGraphReport``: causality (BGI, BGD), conflicts, zero-order causal
-paths, structural controllability and observability, causal equations; as text or a dict."""
+paths, structural controllability and observability, causal equations; as text or a dict.
+
+Switched bonds (``Sw``, hybrid bond graphs) are analysed in their mode-independent resistive
+form (e = s*(Ron if on else 1), f = s*(1 if on else Goff)): one causality for every mode, and
+the structural properties are those of that structure. The ideal modes (Se:0 when on, Sf:0
+when off) are checked for the causality changes the resistive form avoids."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
-from .causality import BGD, BGI, Causality, assign_causality
+from .causality import BGD, BGI, Causality, IdealMode, assign_causality, ideal_modes
 from .equations import CausalEquations, causal_equations
-from .graph import DETECTORS, SOURCES, Graph
+from .graph import DETECTORS, SOURCES, SWITCHES, Graph
 from .structural import StructuralProperty, controllability, observability
 
 __all__ = ["BondGraphReport", "analyze", "as_graph"]
@@ -30,7 +35,8 @@ class BondGraphReport:
     bgi: SCAP with preferred integral causality; bgd: the paper's BGD (all storage elements
     preferably in derivative causality, sources and detectors fixed). controllability /
     observability: Theorems 1 and 2 plus the BGD rank conditions. equations: causal equations
-    read from the BGI.
+    read from the BGI. modes: for each switch and mode, the causality of the ideal mode (see
+    :func:`~bgmodelica.bondgraph.causality.ideal_modes`).
     """
 
     graph: Graph
@@ -39,6 +45,7 @@ class BondGraphReport:
     controllability: StructuralProperty
     observability: StructuralProperty
     equations: CausalEquations
+    modes: list[IdealMode] = field(default_factory=list)
 
     # -- convenience -------------------------------------------------------------------------
     @property
@@ -56,6 +63,47 @@ class BondGraphReport:
     def _t(self, name: str) -> str:
         node = self.graph.nodes[name]
         return f"{name} ({node.title})"
+
+    @property
+    def switches(self) -> list[str]:
+        return [n.name for n in self.graph.nodes.values() if n.kind in SWITCHES]
+
+    def switch_lines(self) -> list[str]:
+        """How the switched bonds are handled (for the causality section of :meth:`to_text`)."""
+        if not self.switches:
+            return []
+        c = self.bgi
+        inc = self.graph.incidence()
+        how = {"resistance": "resistance causality (flow in, effort out)",
+               "conductance": "conductance causality (effort in, flow out)"}
+        lines = ["  switched bonds (hybrid bond graph, Mosterman & Biswas 1998):"]
+        for name in self.switches:
+            node = self.graph.nodes[name]
+            bonds = ", ".join(str(b.number) for b in inc[name]) or "-"
+            caus = how.get(c.switches.get(name, ""), "no causality (unbonded)")
+            lines.append(f"    {self._t(name)}: switched bond {bonds}, causality fixed "
+                         f"(resistive form, Ron/Goff): {caus} in both modes; mode from "
+                         f"{node.mode or '?'}")
+            for m in self.modes:
+                if m.switch != name:
+                    continue
+                ideal = "Se:0, e = 0" if m.mode == "on" else "Sf:0, f = 0"
+                if m.consistent:
+                    verdict = "same storage causality"
+                else:
+                    parts = []
+                    if m.forced:
+                        parts.append("would put " + ", ".join(self._t(x) for x in m.forced)
+                                     + " in derivative causality (resistive form: a fast "
+                                     "mode, time constant set by Ron/Goff)")
+                    if m.conflicts:
+                        parts.append("causal conflict: " + "; ".join(
+                            x.message for x in m.conflicts))
+                    verdict = "; ".join(parts)
+                lines.append(f"      ideal {m.mode} ({ideal}): {verdict}")
+        lines.append("  structural controllability/observability computed for the "
+                     "mode-independent structure (switches in resistive form)")
+        return lines
 
     def to_text(self) -> str:
         g, c = self.graph, self.bgi
@@ -76,6 +124,7 @@ class BondGraphReport:
         if c.resistors:
             lines.append("  resistors: " + ", ".join(f"{self._t(k)} {v}"
                                                      for k, v in c.resistors.items()))
+        lines += self.switch_lines()
         lines.append("  causal conflicts: " + ("; ".join(
             f"{x.element}: {x.message}" for x in c.conflicts) or "none"))
         if c.loops:
@@ -96,7 +145,9 @@ class BondGraphReport:
         for prop, who in ((self.controllability, "source"), (self.observability, "detector")):
             theorem = "Theorem 1" if prop.kind == "controllability" else "Theorem 2"
             verdict = "yes" if prop.ok else "NO"
-            lines.append(f"Structural {prop.kind} ({theorem}): {verdict}")
+            note = " (mode-independent structure, switches in resistive form)" \
+                if self.switches else ""
+            lines.append(f"Structural {prop.kind} ({theorem}): {verdict}{note}")
             for x in prop.states:
                 if x in prop.connected_to:
                     near = prop.connected_to[x]
@@ -128,6 +179,11 @@ class BondGraphReport:
             "controllability": self.controllability.to_dict(),
             "observability": self.observability.to_dict(),
             "equations": self.equations.to_dict(),
+            "switches": [{"name": x, "mode": g.nodes[x].mode,
+                          "causality": self.bgi.switches.get(x),
+                          "fixed_across_modes": True, "form": "resistive (Ron/Goff)"}
+                         for x in self.switches],
+            "ideal_modes": [m.to_dict() for m in self.modes],
         }
 
 
@@ -143,4 +199,5 @@ def analyze(model: Any, inputs: list[str] | None = None,
     bgi = assign_causality(graph, BGI)
     bgd = assign_causality(graph, BGD, check=False)
     return BondGraphReport(graph, bgi, bgd, controllability(graph, bgi, inputs),
-                           observability(graph, bgi, outputs), causal_equations(bgi))
+                           observability(graph, bgi, outputs), causal_equations(bgi),
+                           ideal_modes(graph, bgi))

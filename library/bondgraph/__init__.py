@@ -1,4 +1,5 @@
-"""Bond-graph library: adapters to other domains and the paper's models."""
+"""Bond-graph library: adapters to other domains, the paper's models and switched (hybrid)
+bond graphs."""
 
 from .adapters import FlangeAdapter, PinAdapter
 from .paper import (
@@ -9,6 +10,8 @@ from .paper import (
     TwoLinkArm,
     TwoLinkManipulator,
 )
+from .switched import SwitchedDCMotor, SwitchedRC, SwitchedRL
 
 __all__ = ["FlangeAdapter", "PinAdapter", "DCMotor", "DCMotorDrive", "RotatingArm",
-           "TwoLinkArm", "TwoLinkManipulator", "ARM_MODULI"]
+           "TwoLinkArm", "TwoLinkManipulator", "ARM_MODULI", "SwitchedRL", "SwitchedRC",
+           "SwitchedDCMotor"]

@@ -7,6 +7,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import bgmodelica as bg
+from bgmodelica.errors import SimulationError
 from bgmodelica.passes.index_reduction import reduce_index
 from library.examples.constrained import (
     DoublePendulum,
@@ -91,3 +92,38 @@ def test_check_reports_structure():
     assert len(s["states"]) == 4 and len(s["dummy_derivatives"]) == 8
     assert s["dynamic_state_selection"] is True
     assert any(loop["size"] > 1 for loop in s["algebraic_loops"])
+
+
+# -- accuracy independent of the output grid (dynamic state selection inside the run) ---------
+
+def _pendulum_error(res):
+    """Largest position error against the angle ODE integrated at 1e-13."""
+    from scipy.integrate import solve_ivp
+
+    ref = solve_ivp(lambda _t, s: [s[1], -9.81 * np.sin(s[0])], (0.0, res.time[-1]),
+                    [np.pi / 2, 0.0], method="DOP853", rtol=1e-13, atol=1e-13,
+                    dense_output=True)
+    th = ref.sol(res.time)[0]
+    return max(np.max(np.abs(res["x"] - np.sin(th))), np.max(np.abs(res["y"] + np.cos(th))))
+
+
+@pytest.mark.parametrize("interval", [0.1, 0.01, 0.001])
+def test_pendulum_accuracy_independent_of_output_grid(interval):
+    compiled = bg.compile(Pendulum())
+    res = bg.simulate(compiled, stop_time=5.0, interval=interval)
+    assert _pendulum_error(res) <= 1e-4
+    assert res.meta["state_switches"]
+    # the pivot checks do not depend on the grid: the same switches on every grid
+    times = [round(t, 9) for t, _ in res.meta["state_switches"]]
+    ref = bg.simulate(compiled, stop_time=5.0, interval=0.1)
+    assert times == [round(t, 9) for t, _ in ref.meta["state_switches"]]
+
+
+def test_pendulum_tight_tolerance():
+    res = bg.simulate(Pendulum(), stop_time=5.0, interval=0.01, rtol=1e-10, atol=1e-12)
+    assert _pendulum_error(res) <= 1e-7
+
+
+def test_static_choice_that_degenerates_is_an_error():
+    with pytest.raises(SimulationError, match="degenerates at t = 0.58"):
+        bg.simulate(Pendulum(), stop_time=5.0, interval=0.01, dynamic=False)
