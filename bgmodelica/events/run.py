@@ -40,7 +40,7 @@ def simulate_hybrid(compiled, dae: CasadiDAE, p: np.ndarray, grid: np.ndarray, *
     flat = compiled.reduced.model
     units = {v.name: v.decl.unit for v in flat.variables}
     units.update({d.name: d.decl.unit for d in flat.discretes})
-    params_out = {q.name: float(val) for q, val in zip(dae.parameters, p, strict=False)}
+    params_out = dae.parameter_values(p)
     meta = {"compile_seconds": compiled.compile_time,
             "run_seconds": _time.perf_counter() - t_start,
             "timings": dict(compiled.timings), "solver": "cvodes" if not dae.z.numel()
