@@ -291,3 +291,35 @@ def test_fmu_export_refuses_models_with_events(tmp_path):
 
     with pytest.raises(Exception, match="has events"):
         export_model(BouncingBall(), tmp_path)
+
+
+class Terminal(Component):
+    x = Variable(start=0.0, fixed=True)
+    final = Discrete(start=0.0)
+
+    def equations(self):
+        yield der(self.x) == 1.0
+        yield when(bg.terminal(), self.final == self.x)
+
+
+def test_terminal_fires_once_at_the_stop_time():
+    res = bg.simulate(Terminal(), stop_time=2.0, interval=0.5, **TIGHT)
+    assert res.time[-1] == res.time[-2] == 2.0
+    assert res["final"][-2] == 0.0 and res["final"][-1] == pytest.approx(2.0)
+    assert res.meta["n_events"] == 1
+
+
+def test_cli_input_csv(tmp_path, capsys):
+    from bgmodelica.cli import main
+
+    data = tmp_path / "u.csv"
+    data.write_text("time,u\n0,0\n1,1\n1,-1\n2,-1\n")
+    out = tmp_path / "out.csv"
+    model = f"{__file__}:Inputs"
+    assert main(["simulate", model, "--stop-time", "3", "--interval", "0.5", "--input",
+                 str(data), "-o", str(out), "--rtol", "1e-10", "--atol", "1e-12"]) == 0
+    rows = [line.split(",") for line in out.read_text().splitlines()]
+    assert rows[0][:2] == ["time", "u"] or "x" in rows[0]
+    col = rows[0].index("x")
+    assert float(rows[-1][col]) == pytest.approx(-1.5, abs=1e-8)
+    assert "events: 2" in capsys.readouterr().out
