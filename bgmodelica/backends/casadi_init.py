@@ -26,9 +26,22 @@ class InitialValues:
     notes: list[str] = field(default_factory=list)
 
 
-def initialize(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
-               tol: float = 1e-10) -> InitialValues:
-    """Solve the initial-value problem at ``t0`` for parameter vector ``p``."""
+@dataclass
+class InitStructure:
+    """Which states the initial conditions determine (independent of parameter values).
+
+    x0: start values with the fixed states set; free: indices of the states solved together
+    with z from ``conditions`` ``(observed index, value)``; notes: states left at their start
+    values."""
+
+    x0: np.ndarray
+    free: list[int]
+    conditions: list[tuple[int, float]]
+    notes: list[str]
+
+
+def init_structure(dae: CasadiDAE) -> InitStructure:
+    """Match the fixed start values to the states (raise when they over-determine them)."""
     state_pos = {n: k for k, n in enumerate(dae.state_names)}
     x0 = dae.x_start.copy()
     fixed_states = set()
@@ -71,17 +84,57 @@ def initialize(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
                      + ", ".join(dae.state_names[i] for i in unmatched)
                      + "; their start values were used")
         free = [i for i in free if i not in set(unmatched)]
+    return InitStructure(x0, free, conditions, notes)
+
+
+def _init_residual(dae: CasadiDAE, st: InitStructure) -> ca.Function:
+    """``g(w, [x_pinned, p, t])``: conditions and algebraic equations, w = [x_free, z]."""
+    unknown = ca.vertcat(*[dae.x[i] for i in st.free], dae.z)
+    cond = ca.vertcat(*[dae.observed[k] - v for k, v in st.conditions]) if st.conditions \
+        else ca.SX(0, 1)
+    pinned = [i for i in range(len(st.x0)) if i not in set(st.free)]
+    known = ca.vertcat(*[dae.x[i] for i in pinned]) if pinned else ca.SX(0, 1)
+    return ca.Function("init_g", [unknown, ca.vertcat(known, dae.p, dae.t)],
+                       [ca.vertcat(cond, dae.alg)])
+
+
+def initial_state_function(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
+                           tol: float = 1e-12) -> ca.Function | None:
+    """``(t, p) -> x0`` solving the initial conditions symbolically (code-generatable
+    ``fast_newton``, started from the solution for ``p``), for FMUs whose initial state must
+    follow their parameters as native simulation does; None when the initial state is fixed
+    (no conditions through the model's equations)."""
+    st = init_structure(dae)
+    if not st.conditions:
+        return None
+    sol = initialize(dae, p, t0)
+    g = _init_residual(dae, st)
+    solver = ca.rootfinder("init_solve", "fast_newton", g, {"abstol": tol, "max_iter": 50})
+    pinned = [i for i in range(len(st.x0)) if i not in set(st.free)]
+    t = ca.MX.sym("t")
+    pm = ca.MX.sym("p", dae.p.numel())
+    guess = np.concatenate([sol.x0[st.free], sol.z0])
+    w = solver(ca.DM(guess), ca.vertcat(ca.DM(st.x0[pinned]), pm, t))
+    parts = [None] * len(st.x0)
+    for k, i in enumerate(st.free):
+        parts[i] = w[k]
+    for i in pinned:
+        parts[i] = ca.MX(float(st.x0[i]))
+    return ca.Function("initial_state", [t, pm], [ca.vertcat(*parts)], ["t", "p"], ["x0"])
+
+
+def initialize(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
+               tol: float = 1e-10) -> InitialValues:
+    """Solve the initial-value problem at ``t0`` for parameter vector ``p``."""
+    st = init_structure(dae)
+    x0, free, conditions, notes = st.x0.copy(), st.free, st.conditions, list(st.notes)
+    nz = dae.z.numel()
     z0 = dae.z_start.copy()
     if not conditions and nz == 0:
         return InitialValues(x0, z0, notes)
-    unknown = ca.vertcat(*[dae.x[i] for i in free], dae.z)
     guess = np.concatenate([x0[free], z0])
-    cond = ca.vertcat(*[dae.observed[k] - v for k, v in conditions]) if conditions \
-        else ca.SX(0, 1)
     pinned = [i for i in range(len(x0)) if i not in set(free)]
-    known = ca.vertcat(*[dae.x[i] for i in pinned]) if pinned else ca.SX(0, 1)
-    residual = ca.vertcat(cond, dae.alg)
-    g = ca.Function("init_g", [unknown, ca.vertcat(known, dae.p, dae.t)], [residual])
+    g = _init_residual(dae, st)
     args = np.concatenate([x0[pinned], p, [t0]])
     r0 = np.asarray(g(guess, args)).ravel()
     if r0.size and np.max(np.abs(r0)) > tol:
