@@ -33,6 +33,7 @@ class StateSelector:
     threshold: float = 0.3
     variants: dict[tuple[int, ...], CompiledModel] = field(default_factory=dict)
     switches: list[tuple[float, list[str]]] = field(default_factory=list)
+    last_ratio: float = 1.0        # pivot score of the current choice / the best, last check
 
     def __post_init__(self) -> None:
         red = self.base.reduced
@@ -100,6 +101,7 @@ class StateSelector:
               t: float) -> CompiledModel:
         """Return the variant to continue with at time ``t`` given all variable values."""
         now, best_score, dummies, levels = self.assess(current, values, p, t)
+        self.last_ratio = now / best_score if best_score > 0 else 1.0
         if now >= self.threshold * best_score:
             return current
         key = self.key(dummies)

@@ -15,7 +15,10 @@ the event) and the right limit (after the event iteration and re-initialization)
 
 from __future__ import annotations
 
+import contextlib
 import math
+import os
+import sys
 from collections import deque
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -216,7 +219,11 @@ class HybridSimulator:
         offsets = np.union1d(out_offsets, uniform)
         offsets = offsets[offsets > 0]
         try:
-            X, Z = self._columns(t0, x, z, offsets)
+            if sel is None:
+                X, Z = self._columns(t0, x, z, offsets)
+            else:        # a failure is expected now and then (retried): keep SUNDIALS quiet
+                with _quiet_stderr():
+                    X, Z = self._columns(t0, x, z, offsets)
         except RuntimeError:
             # with dynamic state selection the current choice may fail before the next pivot
             # check: integrate a shorter stretch, whose checks switch the states in time
@@ -643,6 +650,26 @@ class HybridSimulator:
 
     def _obs(self, t, x, z) -> np.ndarray:
         return self._step_fast(t, x, z, self.p)[6][self.obs_idx]
+
+
+@contextlib.contextmanager
+def _quiet_stderr():
+    """Silence C-level stderr (SUNDIALS prints its error messages there)."""
+    try:
+        fd = sys.stderr.fileno()
+    except (AttributeError, OSError, ValueError):
+        yield
+        return
+    sys.stderr.flush()
+    saved = os.dup(fd)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, fd)
+        yield
+    finally:
+        os.dup2(saved, fd)
+        os.close(saved)
+        os.close(devnull)
 
 
 def _count(items: list[str]) -> dict[str, int]:
