@@ -5,6 +5,7 @@ each chain node to ground starts at v = i. Simulated 0..10 s with IDAS (BDF, spa
 linear solver). Prints build (flatten + compile) and solve seconds per n, and the stage split.
 
     python benchmarks/rc_ladder.py [n ...]
+    python benchmarks/rc_ladder.py --units [n]     # compile time with and without the unit check
 """
 
 from __future__ import annotations
@@ -49,7 +50,39 @@ def run(n: int) -> dict[str, float]:
             **{f"stage_{k}": v for k, v in compiled.timings.items()}}
 
 
+def units_overhead(n: int, reps: int = 3) -> None:
+    """Compile the ladder with ``units="off"`` and ``"error"`` alternately in this process
+    (pint and its registry loaded beforehand) and print the best time of each."""
+    import gc
+
+    from bgmodelica.core.units import parse
+
+    t0 = time.perf_counter()
+    parse("V")
+    print(f"unit registry ready in {time.perf_counter() - t0:.3f} s (once per process; "
+          "nothing when the units were seen before)")
+    best = {"off": float("inf"), "error": float("inf")}
+    stage = {"off": float("inf"), "error": float("inf")}
+    for rep in range(reps):
+        for mode in ("off", "error") if rep % 2 == 0 else ("error", "off"):
+            model = rc_ladder(n)
+            gc.collect()
+            t1 = time.perf_counter()
+            compiled = bg.compile(model, units=mode)
+            best[mode] = min(best[mode], time.perf_counter() - t1)
+            stage[mode] = min(stage[mode], compiled.timings["units"])
+            del compiled, model
+    extra = best["error"] - best["off"]
+    check = stage["error"] - stage["off"]       # the "units" lap also frees the equation trees
+    print(f"n={n}: compile {best['off']:.3f} s without the unit check, {best['error']:.3f} s "
+          f"with it ({extra:+.3f} s, {100 * extra / best['off']:+.1f}%); the check itself "
+          f"{check:.3f} s ({100 * check / best['off']:.1f}%)")
+
+
 def main(argv: list[str]) -> None:
+    if argv[:1] == ["--units"]:
+        units_overhead(int(argv[1]) if len(argv) > 1 else 10000)
+        return
     sizes = [int(a) for a in argv] or [10, 100, 1000, 10000]
     print(f"{'n':>6} {'build[s]':>9} {'solve[s]':>9} {'total[s]':>9}  stages")
     for n in sizes:

@@ -72,3 +72,11 @@ from .result import Result  # noqa: E402
 from .simulate import simulate  # noqa: E402
 
 __all__ += ["compile", "simulate", "CompiledModel", "Result"]
+
+from .analysis import linearize, steady_state  # noqa: E402
+
+__all__ += ["linearize", "steady_state"]
+
+from .studies import fit, sweep  # noqa: E402  (Dask and xarray load only when a study runs)
+
+__all__ += ["sweep", "fit"]

@@ -1,3 +1,4 @@
+# PYTHON_ARGCOMPLETE_OK
 """The ``bgmodelica`` command line: simulate, check (and the commands added by later stages)."""
 
 from __future__ import annotations
@@ -5,6 +6,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -12,8 +14,12 @@ from typing import Any
 from .errors import ModelError, ModelLoadError, ParameterError
 
 
-def _parse_sets(items: Sequence[str]) -> dict[str, float]:
-    out: dict[str, float] = {}
+def _parse_sets(items: Sequence[str]) -> dict[str, float | str]:
+    """``NAME=VALUE`` pairs; a value with a unit (``R.R="2 kOhm"``) stays a string, converted
+    to the declared unit by ``simulate``."""
+    from .core.units import split_quantity
+
+    out: dict[str, float | str] = {}
     for item in items:
         name, sep, value = item.partition("=")
         if not sep or not name:
@@ -21,42 +27,89 @@ def _parse_sets(items: Sequence[str]) -> dict[str, float]:
         try:
             out[name.strip()] = float(value)
         except ValueError:
-            raise ParameterError(f"--set {name}: {value!r} is not a number") from None
+            quantity = split_quantity(value)
+            if quantity is None or not quantity[1]:
+                raise ParameterError(f"--set {name}: {value!r} is not a number") from None
+            out[name.strip()] = value.strip()
     return out
 
 
 def _model_kwargs(items: Sequence[str]) -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    for item in items:
-        name, _, value = item.partition("=")
-        try:
-            out[name] = json.loads(value)
-        except json.JSONDecodeError:
-            out[name] = value
-    return out
+    from .validate import parse_model_args
+
+    return parse_model_args(items)
+
+
+#: the terminal's stderr while :func:`main` holds back the output of a command
+_TERMINAL: Any = None
 
 
 def _progress(frac: float) -> None:
+    stream = _TERMINAL or sys.stderr
     bar = "#" * int(frac * 30)
-    sys.stderr.write(f"\r  simulating [{bar:<30}] {frac * 100:5.1f}%")
+    stream.write(f"\r  simulating [{bar:<30}] {frac * 100:5.1f}%")
     if frac >= 1:
-        sys.stderr.write("\n")
-    sys.stderr.flush()
+        stream.write("\n")
+    stream.flush()
+
+
+def _check_simulate_args(args: argparse.Namespace) -> None:
+    """Options and output files, before any model is loaded (nothing is written)."""
+    from .errors import OptionError
+    from .validate import (
+        check_distinct_outputs,
+        check_output_file,
+        check_plot_file,
+        check_run_options,
+    )
+
+    check_run_options(stop_time=args.stop_time, interval=args.interval, rtol=args.rtol,
+                      atol=args.atol)
+    if args.plot_vars and not args.plot:
+        raise OptionError("--plot-vars needs --plot FILE to draw them in")
+    if args.output:
+        check_output_file(args.output, "-o")
+    if args.plot:
+        check_plot_file(args.plot, "--plot")
+    check_distinct_outputs(("-o", args.output), ("--plot", args.plot))
+    if args.input and not Path(args.input).is_file():
+        raise OptionError(f"--input {args.input}: no such file")
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
+    from .cli_tools import choose_solver
     from .compiler import compile
+    from .errors import SimulationError
     from .loader import load_model
     from .simulate import simulate
+    from .validate import check_distinct_outputs, check_output_file, check_plot_vars
 
-    model = load_model(args.model, **_model_kwargs(args.arg))
+    _check_simulate_args(args)
     params = _parse_sets(args.set)
-    compiled = compile(model)
-    show = args.progress if args.progress is not None else sys.stderr.isatty()
-    result = simulate(compiled, stop_time=args.stop_time, interval=args.interval,
-                      params=params, rtol=args.rtol, atol=args.atol,
-                      progress=_progress if show else None, inputs=args.input)
+    model = load_model(args.model, **_model_kwargs(args.arg))
+    compiled = compile(model, units=args.units)
     out = Path(args.output) if args.output else Path(f"{compiled.name}.csv")
+    if not args.output:
+        check_output_file(out, "-o (default)")
+        check_distinct_outputs(("-o", out), ("--plot", args.plot))
+    if args.plot_vars:
+        check_plot_vars(args.plot_vars, compiled)
+    show = args.progress if args.progress is not None else (_TERMINAL or sys.stderr).isatty()
+    try:
+        result = simulate(compiled, stop_time=args.stop_time, interval=args.interval,
+                          params=params, rtol=args.rtol, atol=args.atol,
+                          solver=choose_solver(args.solver, compiled), max_step=args.max_step,
+                          progress=_progress if show else None, inputs=args.input,
+                          init=args.init)
+    except SimulationError as err:          # keep what was computed, and say so
+        part = err.result
+        if part is None or not len(part.time):
+            raise SimulationError(f"{err} (nothing written to {out})", err.time_reached,
+                                  part) from None
+        part.to_csv(out)
+        raise SimulationError(f"{err} -- {len(part.time)} rows up to t = "
+                              f"{float(part.time[-1]):g} s written to {out}",
+                              err.time_reached, part) from None
     result.to_csv(out)
     print(f"{compiled.name}: {len(result.time)} points, compile {compiled.compile_time:.3f} s, "
           f"run {result.meta['run_seconds']:.3f} s -> {out}")
@@ -74,12 +127,18 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 def cmd_check(args: argparse.Namespace) -> int:
     from .compiler import compile
     from .loader import load_model
+    from .validate import check_values
 
     model = load_model(args.model, **_model_kwargs(args.arg))
-    summary = compile(model).summary()
+    compiled = compile(model, units=args.units)
+    check_values(compiled.dae, compiled.dae.p_default, compiled.reduced.model)
+    summary = compiled.summary()
     extra = _bondgraph_report(model)
     if extra is not None:
         summary["bond_graph"] = extra.to_dict()
+        beside = _structural_vs_numeric(model, compiled, extra)
+        if beside is not None:
+            summary["bond_graph"]["structural_vs_numeric"] = beside.to_dict()
     if args.json:
         print(json.dumps(summary, indent=2))
         return 0
@@ -124,6 +183,8 @@ def cmd_check(args: argparse.Namespace) -> int:
         print(f"  inputs: {', '.join(summary['inputs'])}")
     if extra is not None:
         print(extra.to_text())
+        if beside is not None:
+            print(beside.to_text())
     return 0
 
 
@@ -131,10 +192,13 @@ def cmd_export(args: argparse.Namespace) -> int:
     from .compiler import compile
     from .fmi.from_model import export_model
     from .loader import load_model
+    from .validate import check_export_args
 
-    compiled = compile(load_model(args.model, **_model_kwargs(args.arg)))
+    check_export_args(args)
+    compiled = compile(load_model(args.model, **_model_kwargs(args.arg)), units=args.units)
     path = export_model(compiled, args.output, fmi_version=args.fmi, fmu_type=args.type,
-                        stop_time=args.stop_time, step_size=args.step)
+                        stop_time=args.stop_time, step_size=args.step,
+                        static_states=args.static_states)
     print(f"{compiled.name}: FMI {args.fmi}.0 {args.type.upper()} -> {path}")
     if args.validate:
         from fmpy.validation import validate_fmu
@@ -148,13 +212,22 @@ def cmd_export(args: argparse.Namespace) -> int:
 def cmd_draw(args: argparse.Namespace) -> int:
     from .bondgraph import BondGraph, draw
     from .loader import load_model
+    from .validate import check_plot_file
 
+    check_plot_file(args.output, "-o")
     model = load_model(args.model, **_model_kwargs(args.arg))
     if not isinstance(model, BondGraph):
         raise ModelLoadError(f"{args.model} is a {type(model).__name__}, not a BondGraph")
     path = draw(model, args.output)
     print(f"drawing -> {path}")
     return 0
+
+
+def _structural_vs_numeric(model: Any, compiled: Any, report: Any) -> Any:
+    """Numeric ranks beside the structural ones (:mod:`bgmodelica.analysis.compare`)."""
+    from .analysis.compare import compare_bond_graph
+
+    return compare_bond_graph(model, compiled, report)
 
 
 def _bondgraph_report(model: Any) -> Any:
@@ -165,10 +238,21 @@ def _bondgraph_report(model: Any) -> Any:
     return analyze(model) if isinstance(model, BondGraph) else None
 
 
+class _Parser(argparse.ArgumentParser):
+    """Usage errors on one line (sub-parsers inherit the class)."""
+
+    def error(self, message: str):  # type: ignore[override]
+        sys.stderr.write(f"error: {self.prog}: {message} (see {self.prog} --help)\n")
+        raise SystemExit(2)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="bgmodelica",
         description="Equation-based modeling with bond graphs: simulate, check, export.")
+    from . import __version__
+
+    parser.add_argument("--version", action="version", version=f"bgmodelica {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
     def model_args(p: argparse.ArgumentParser) -> None:
@@ -182,6 +266,10 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--interval", type=float, default=None, help="output step [s]")
     sim.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                      help="override a parameter / input / start value by dotted name")
+    sim.add_argument("--init", choices=("start", "steady-state"), default="start",
+                     help="initial conditions: the start values and initial equations "
+                          "(default), or the steady state der(x) = 0 with the given inputs "
+                          "(start values as guesses)")
     sim.add_argument("--input", metavar="FILE.csv",
                      help="time-varying values of the model's inputs: first column 'time', "
                           "one column per input (linear; a repeated time is a jump)")
@@ -190,6 +278,11 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--plot-vars", nargs="+", help="variables to plot")
     sim.add_argument("--rtol", type=float, default=1e-6)
     sim.add_argument("--atol", type=float, default=1e-8)
+    sim.add_argument("--solver", choices=("idas", "cvodes", "auto"), default="idas",
+                     help="integrator: IDAS (DAEs, default), CVODES (explicit ODEs) or auto "
+                          "(CVODES when no algebraic unknowns are left)")
+    sim.add_argument("--max-step", type=float, default=None, metavar="SECONDS",
+                     help="largest internal step of the integrator [s]")
     sim.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                      help="progress bar (default: when stderr is a terminal)")
     sim.set_defaults(func=cmd_simulate)
@@ -207,7 +300,15 @@ def build_parser() -> argparse.ArgumentParser:
     exp.add_argument("--stop-time", type=float, default=1.0, help="DefaultExperiment stop [s]")
     exp.add_argument("--step", type=float, default=None, help="DefaultExperiment step [s]")
     exp.add_argument("--validate", action="store_true", help="run fmpy's validate_fmu")
+    exp.add_argument("--static-states", action="store_true",
+                     help="export a model that needs dynamic state selection with its compiled "
+                          "states (valid only where they do not degenerate)")
     exp.set_defaults(func=cmd_export)
+
+    for p in (sim, chk, exp):
+        p.add_argument("--units", choices=("error", "warn", "off"), default="error",
+                       help="dimensional analysis of the equations: a mismatch is an error "
+                            "(default), a warning, or not checked")
 
     drw = sub.add_parser("draw", help="draw a bond graph with causal strokes (SVG/PNG)")
     model_args(drw)
@@ -224,22 +325,91 @@ from .cosim.cli import register as register_cosim  # noqa: E402
 
 _EXTENSIONS.append(register_cosim)
 
+from .studies.cli import register as register_studies  # noqa: E402
+
+_EXTENSIONS.append(register_studies)
+
+from .analysis.cli import register as register_analysis  # noqa: E402
+
+_EXTENSIONS.append(register_analysis)
+
+from .cli_tools import register as register_tools  # noqa: E402
+
+_EXTENSIONS.append(register_tools)
+
+
+def _autocomplete(parser: argparse.ArgumentParser) -> None:
+    from .cli_tools import autocomplete
+
+    autocomplete(parser)
+
+
+def _unit_warning() -> type:
+    from .passes.units import UnitWarning
+
+    return UnitWarning
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Unit mismatches (``--units warn``) as one ``warning:`` line, others as usual."""
+    if issubclass(category, _unit_warning()):
+        print(f"warning: {message}", file=sys.stderr)
+    else:
+        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+
+
+#: commands whose stderr (solver chatter, warnings) is held back and shown only on success,
+#: so that an error is the one line on stderr
+_HOLD_STDERR = {"simulate", "check", "export", "draw", "linearize"}
+
+
+def _error_line(err: BaseException) -> str:
+    from .validate import one_line
+
+    return f"error: {type(err).__name__}: {one_line(str(err))}"
+
 
 def main(argv: Sequence[str] | None = None) -> int:
+    global _TERMINAL
+    import contextlib
+    import io
+
     parser = build_parser()
-    args = parser.parse_args(argv)
+    _autocomplete(parser)
     try:
-        return int(args.func(args) or 0)
+        args = parser.parse_args(argv)
+    except SystemExit as done:            # usage error (one line) or --help
+        return int(done.code or 0) if not isinstance(done.code, str) else 2
+    held = io.StringIO() if args.command in _HOLD_STDERR else None
+    terminal = sys.stderr
+    _TERMINAL = terminal
+    ok = False
+    try:
+        with warnings.catch_warnings(), (contextlib.redirect_stderr(held) if held is not None
+                                         else contextlib.nullcontext()):
+            warnings.showwarning = _show_warning
+            warnings.simplefilter("always", _unit_warning())
+            code = int(args.func(args) or 0)
+        ok = True
+        return code
     except ModelError as err:
-        print(f"error: {type(err).__name__}: {err}", file=sys.stderr)
+        print(_error_line(err), file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("error: interrupted", file=sys.stderr)
+        return 130
     except Exception as err:  # FMU build errors and the like: one line, not a traceback
         from .fmi import FmuExportError
 
         if not isinstance(err, FmuExportError):
+            ok = True                       # an internal error: show everything
             raise
-        print(f"error: {type(err).__name__}: {err}", file=sys.stderr)
+        print(_error_line(err), file=sys.stderr)
         return 2
+    finally:
+        _TERMINAL = None
+        if held is not None and ok:
+            terminal.write(held.getvalue())
 
 
 if __name__ == "__main__":

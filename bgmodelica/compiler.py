@@ -8,15 +8,18 @@ import time as _time
 from dataclasses import dataclass, field
 from typing import Any
 
-from .backends.casadi_dae import CasadiDAE, build_dae
+from .backends.casadi_dae import CasadiDAE, attach_initial_equations, build_dae
 from .core.component import Component
 from .core.flatmodel import FlatModel
 from .core.flatten import flatten
-from .errors import DeclarationError
+from .errors import DeclarationError, UnbalancedModelError
 from .passes.alias import eliminate_aliases
 from .passes.balance import BalanceReport, check_balance
 from .passes.index_reduction import ReducedModel, Selector, reduce_index
+from .passes.reference import check_references
 from .passes.sorting import SortedDAE, sort_equations
+from .passes.state_select import check_alias_state_select, check_states
+from .passes.units import check_units
 from .structure.graph import gc_paused
 
 
@@ -37,6 +40,12 @@ class CompiledModel:
     @property
     def compile_time(self) -> float:
         return sum(self.timings.values())
+
+    def _repr_html_(self) -> str:
+        """Jupyter view: structure and parameters (:func:`bgmodelica.notebook.compiled_html`)."""
+        from .notebook import compiled_html
+
+        return compiled_html(self)
 
     def needs_dynamic_selection(self) -> bool:
         """Whether simulation must be ready to change the states (their pivots vary)."""
@@ -88,7 +97,9 @@ class CompiledModel:
                                                                         "terminal()"))]
         discrete = [{"name": d.name, "type": getattr(d.decl, "type_name", "Real"),
                      "assigned": "when"} for d in shown]
-        discrete += [{"name": n, "type": "Real", "assigned": "equation"}
+        decls = {v.name: v.decl for v in self.reduced.model.variables}
+        discrete += [{"name": n, "type": getattr(decls.get(n), "type_name", "Real"),
+                      "assigned": "equation"}
                      for n in sorted(self.dae.discrete_names) if n not in {d.name for d in shown}]
         import casadi as ca
 
@@ -112,16 +123,21 @@ class CompiledModel:
         }
 
 
-def compile(model: Component, *, select: Selector | None = None) -> CompiledModel:  # noqa: A001
+def compile(model: Component, *, select: Selector | None = None,  # noqa: A001
+            units: str = "error") -> CompiledModel:
     """Compile a component tree into a :class:`CompiledModel`.
+
+    units: dimensional analysis of every equation (:mod:`bgmodelica.passes.units`):
+    ``"error"`` raises :class:`~bgmodelica.errors.UnitError` at a mismatch, ``"warn"`` warns,
+    ``"off"`` skips it.
 
     The cyclic garbage collector is paused meanwhile: compilation allocates millions of
     objects that live until the end, and rescanning them costs more than it frees."""
     with gc_paused():
-        return _compile(model, select)
+        return _compile(model, select, units)
 
 
-def _compile(model: Component, select: Selector | None) -> CompiledModel:
+def _compile(model: Component, select: Selector | None, units: str = "error") -> CompiledModel:
     if not isinstance(model, Component):
         raise DeclarationError(
             f"compile() expects a Component instance, got {type(model).__name__}")
@@ -137,9 +153,19 @@ def _compile(model: Component, select: Selector | None) -> CompiledModel:
     flat = flatten(model)
     n_flat = len(flat.equations)
     lap("flatten")
+    check_units(flat, units)
+    flat.sources = None
+    lap("units")
+    check_references(flat)             # a floating network (no ground) named, not its symptom
+    check_alias_state_select(flat)
+    raw = flat
     flat = eliminate_aliases(flat)
     lap("alias")
-    balance = check_balance(flat)
+    try:
+        balance = check_balance(flat)
+    except UnbalancedModelError:
+        check_references(raw, force=True)  # large models: the likely cause, if it is that
+        raise
     lap("balance")
     return _reduce_and_build(flat, balance, n_flat, timings, model, select)
 
@@ -162,10 +188,13 @@ def _reduce_and_build(flat: FlatModel, balance: BalanceReport, n_flat: int,
         t = now
 
     reduced = reduce_index(flat, select=select)
+    if select is None:
+        check_states(reduced)
     lap("index_reduction")
     sorted_dae = sort_equations(reduced)
     lap("sorting")
     dae = build_dae(sorted_dae)
+    attach_initial_equations(dae, flat)
     lap("backend")
     return CompiledModel(flat.name, flat, balance, reduced, sorted_dae, dae, n_flat, timings,
                          source)

@@ -23,6 +23,11 @@ class EquationError(ModelError):
     """An equation is malformed (not ``lhs == rhs``, no unknowns, non-scalar...)."""
 
 
+class UnitError(ModelError):
+    """The units of an equation do not agree (names the component, the equation as written
+    and the two units), or a value's unit cannot be converted to the declared one."""
+
+
 class UnbalancedModelError(ModelError):
     """The number of equations differs from the number of unknowns, or the system is
     structurally singular. ``missing`` lists variables no equation determines, ``surplus`` the
@@ -54,3 +59,23 @@ class SimulationError(ModelError):
         super().__init__(message)
         self.time_reached = time_reached
         self.result = result
+
+
+class OptionError(ParameterError):
+    """A simulation or command-line option is unusable (stop time, interval, tolerances,
+    output file, plot variables or format, ``--arg`` value); the message names the option."""
+
+
+class StateSelectError(DeclarationError):
+    """``state_select`` declarations that contradict each other or the model's structure."""
+
+
+class UserCodeError(ModelError):
+    """User code raised an exception while a model was built (a constructor, an
+    ``equations()`` method, a model file's module code). ``path`` is the component path,
+    ``location`` the user's ``file:line``, ``__cause__`` the original exception."""
+
+    def __init__(self, message: str, path: str = "", location: str = "") -> None:
+        super().__init__(message)
+        self.path = path
+        self.location = location

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import csv
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -59,44 +58,79 @@ class Result:
         """Every name the result answers to, computed variables first, then aliases."""
         return list(self.names) + sorted(self.aliases)
 
+    def sensitivity(self, name: str, param: str) -> np.ndarray:
+        """d(name)/d(param) along ``time`` of a run made with ``simulate(...,
+        sensitivities=[param, ...])`` (see :mod:`bgmodelica.studies.sensitivity`)."""
+        from .studies.sensitivity import sensitivity_of
+
+        return sensitivity_of(self, name, param)
+
     def final(self, name: str) -> float:
         return float(self[name][-1])
 
-    def to_csv(self, path: str | Path, names: Sequence[str] | None = None) -> Path:
-        """Write ``time,<names>`` (default: every variable incl. aliases) to a CSV file."""
-        names = list(names) if names is not None else self.all_names()
-        cols = np.column_stack([self.time] + [self[n] for n in names])
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with path.open("w", newline="") as fh:
-            writer = csv.writer(fh)
-            writer.writerow(["time", *names])
-            writer.writerows(np.char.mod("%.12g", cols).tolist())
-        return path
+    def unit(self, name: str) -> str:
+        """The unit of ``name`` ("" if dimensionless or not declared; aliases resolved)."""
+        from .dataio import unit_of
 
-    def plot(self, names: Iterable[str], path: str | Path | None = None,
-             title: str | None = None, ax: Any = None) -> Any:
-        """Plot variables against time; save to ``path`` if given. Returns the figure."""
-        import matplotlib
+        return unit_of(self, name)
 
-        if path is not None:
-            matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+    def to_csv(self, path: str | Path, names: Sequence[str] | None = None, *,
+               units: bool = False) -> Path:
+        """Write ``time,<names>`` (default: every variable incl. aliases) to a CSV file;
+        ``units=True`` adds a second header row with the units (``s,V,A,...``). At an event
+        instant there are two rows with the same time (left and right limit).
+        :meth:`read_csv` reads it back."""
+        from .dataio import write_csv
 
-        names = list(names)
-        fig = None
-        if ax is None:
-            fig, ax = plt.subplots(figsize=(8, 4.5))
-        for n in names:
-            unit = self.units.get(n, "")
-            ax.plot(self.time, self[n], label=f"{n} [{unit}]" if unit else n)
-        ax.set_xlabel("time [s]")
-        ax.grid(True, alpha=0.3)
-        ax.legend(loc="best", fontsize=8)
-        if title:
-            ax.set_title(title)
-        if path is not None and fig is not None:
-            fig.tight_layout()
-            fig.savefig(path, dpi=120)
-            plt.close(fig)
-        return fig
+        return write_csv(self, path, names, units=units)
+
+    @classmethod
+    def read_csv(cls, path: str | Path) -> Result:
+        """A result from a CSV file written by :meth:`to_csv` (units row optional)."""
+        from .dataio import read_csv
+
+        return read_csv(path)
+
+    def to_pandas(self, names: Sequence[str] | None = None) -> Any:
+        """A :class:`pandas.DataFrame` indexed by ``time`` (not unique at events: two rows,
+        left and right limit), columns by dotted name, units in ``df.attrs["units"]``,
+        parameters in ``df.attrs["parameters"]`` (see :mod:`bgmodelica.dataio`)."""
+        from .dataio import to_pandas
+
+        return to_pandas(self, names)
+
+    def to_xarray(self, names: Sequence[str] | None = None, parameters: bool = True) -> Any:
+        """An :class:`xarray.Dataset` along ``time`` with ``attrs["units"]`` on every
+        variable; parameters as 0-d variables (see :mod:`bgmodelica.dataio`)."""
+        from .dataio import to_xarray
+
+        return to_xarray(self, names, parameters)
+
+    @classmethod
+    def from_pandas(cls, df: Any) -> Result:
+        """The inverse of :meth:`to_pandas`."""
+        from .dataio import from_pandas
+
+        return from_pandas(df)
+
+    @classmethod
+    def from_xarray(cls, ds: Any) -> Result:
+        """The inverse of :meth:`to_xarray`."""
+        from .dataio import from_xarray
+
+        return from_xarray(ds)
+
+    def plot(self, names: Iterable[str] | None = None, path: str | Path | None = None,
+             title: str | None = None, ax: Any = None, **options: Any) -> Any:
+        """Plot variables against time, one stacked subplot per unit, events marked;
+        ``names`` default to the states. Saves to ``path`` if given. Returns the figure.
+        ``options``: ``style`` ("paper" or None), ``events``, ``figsize``
+        (see :func:`bgmodelica.plotting.plot_result`)."""
+        from .plotting import plot_result
+
+        return plot_result(self, names, path, title, ax, **options)
+
+    def _repr_html_(self) -> str:
+        from .notebook import result_html
+
+        return result_html(self)

@@ -13,8 +13,11 @@ from .backends.casadi_dae import CasadiDAE
 from .backends.casadi_init import initialize
 from .compiler import CompiledModel, compile
 from .core.component import Component
+from .core.units import with_units
+from .diagnose import check_initial_point, check_result
 from .errors import ParameterError, SimulationError
 from .result import Result
+from .validate import check_run_options, check_values, output_grid
 
 _HINTS = {
     "IDA_CONV_FAIL": "the Newton iteration failed repeatedly: the model may be singular at "
@@ -37,10 +40,24 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
              max_step: float | None = None, max_steps: int = 100000, solver: str = "idas",
              outputs: Sequence[str] | None = None, dynamic: bool = True,
              progress: Callable[[float], None] | None = None,
-             inputs: Any = None) -> Result:
+             inputs: Any = None, units: str = "error",
+             sensitivities: Sequence[str] | None = None,
+             sensitivity_method: str = "forward", init: str = "start") -> Result:
     """Simulate ``model`` from ``start_time`` to ``stop_time`` [s].
 
-    interval: output grid step [s] (default: 500 intervals). params: overrides by dotted name
+    init: ``"start"`` (default): the initial conditions are the fixed start values and the
+    components' initial equations; ``"steady-state"``: the steady state der(x) = 0 with the
+    given parameters and inputs, every start value a guess (see
+    :func:`bgmodelica.steady_state`).
+
+    interval: output grid step [s]: the result holds exactly ``start_time + k*interval``
+    below ``stop_time``, then ``stop_time`` (default: 500 equal intervals). Options that are
+    NaN, Inf, zero or negative, or a grid too large to hold, raise
+    :class:`~bgmodelica.errors.OptionError`; parameters and fixed start values outside their
+    declared ``min``/``max`` :class:`ParameterError`; a model undefined at its initial point
+    (division by zero, log of a negative number) :class:`InitializationError` naming the
+    equation; NaN/Inf in the result :class:`SimulationError` naming the variable and time,
+    with ``.result`` holding the rows before. params: overrides by dotted name
     of parameters, model inputs (held constant) or start values of variables. rtol/atol:
     integrator tolerances; max_step: largest internal step [s]. solver: "idas" (default) or
     "cvodes" (ODE models only). outputs: names to record (default: every variable).
@@ -49,30 +66,70 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
     progress: called with the fraction done after each chunk of the run.
     inputs: time-varying values of top-level ``Input``s: a CSV path or a mapping of input name
     to ``(times, values)`` (see :mod:`bgmodelica.events.inputs`).
+    A value in ``params`` may carry a unit (``{"R.R": "2 kOhm"}``): it is converted to the
+    declared unit. units: the unit check of :func:`~bgmodelica.compile` when ``model`` is a
+    component ("error", "warn" or "off").
 
     Models with events (relations, ``when``, ``sample``, tables) or with ``inputs`` run in
     the event loop (:mod:`bgmodelica.events`): at every event the result holds two rows with
     the same time, the left and the right limit; ``result.meta["event_times"]`` lists them.
+
+    sensitivities: parameters / inputs p_j to differentiate the recorded variables with
+    respect to: ``result.sensitivity("rotor.w", "resistor.R")`` is d(rotor.w)/d(resistor.R)
+    along ``result.time``. sensitivity_method: ``"forward"`` (CVODES/IDAS forward
+    sensitivities through CasADi; refused for models with events) or ``"fd"`` (central finite
+    differences of whole runs, labelled so in ``result.meta["sensitivity_method"]``); see
+    :mod:`bgmodelica.studies.sensitivity`.
     """
-    compiled = model if isinstance(model, CompiledModel) else compile(model)
+    opt = check_run_options(start_time=start_time, stop_time=stop_time, interval=interval,
+                            rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps,
+                            solver=solver)
+    start_time, stop_time, interval = opt["start_time"], opt["stop_time"], opt["interval"]
+    rtol, atol, max_step = opt["rtol"], opt["atol"], opt["max_step"]
+    compiled = model if isinstance(model, CompiledModel) else compile(model, units=units)
     dae = compiled.dae
     t_start = _time.perf_counter()
-    p_over, start_over = _split_overrides(dae, params or {})
+    params = with_units(params or {}, compiled)
+    p_over, start_over = _split_overrides(dae, params)
     p = dae.p_vector(p_over)
     if start_over:
         dae = _with_starts(dae, start_over)
-    if stop_time <= start_time:
-        raise ParameterError(f"stop_time ({stop_time}) must be after start_time ({start_time})")
-    n_int = max(1, int(round((stop_time - start_time) / interval))) if interval else 500
-    grid = np.linspace(start_time, stop_time, n_int + 1)
+    if init != "start":
+        from .analysis.steady_state import steady_state_dae
+
+        dae = steady_state_dae(compiled, dae, p, start_time, init)
+    check_values(dae, p, compiled.reduced.model)
+    grid = output_grid(start_time, stop_time, interval,        # exactly the points asked for
+                       len(outputs) if outputs is not None else len(dae.names))
     selection = _selection(compiled, dynamic, start_over, stop_time - start_time)
+    if init != "start" and selection is not None:     # other states: the same steady values
+        from .analysis.steady_state import fixed_at_values
+
+        selection.prepare = fixed_at_values(dae, p, start_time)
+    if sensitivities is not None:
+        from .studies.sensitivity import simulate_sensitivities
+
+        return simulate_sensitivities(compiled, dae, p, grid, sensitivities,
+                                      method=sensitivity_method, outputs=outputs, rtol=rtol,
+                                      atol=atol, max_step=max_step, max_steps=max_steps,
+                                      inputs=inputs, selection=selection, params=params,
+                                      t_start=t_start, solver=solver)
     if dae.hybrid is not None or inputs is not None or selection is not None:
         from .events.run import simulate_hybrid
 
-        return simulate_hybrid(compiled, dae, p, grid, rtol=rtol, atol=atol, max_step=max_step,
-                               max_steps=max_steps, outputs=outputs, inputs=inputs,
-                               t_start=t_start, selection=selection, progress=progress)
+        try:
+            result = simulate_hybrid(compiled, dae, p, grid, rtol=rtol, atol=atol,
+                                     max_step=max_step, max_steps=max_steps, outputs=outputs,
+                                     inputs=inputs, t_start=t_start, selection=selection,
+                                     progress=progress)
+        except SimulationError as err:      # NaN / Inf in the rows computed: say where
+            if err.result is not None:
+                check_result(err.result, dae, p)
+            raise
+        check_result(result, dae, p)
+        return result
     init = initialize(dae, p, start_time)
+    check_initial_point(dae, init.x0, init.z0, p, start_time)
     obs_idx = _output_indices(dae, outputs, compiled.reduced.model.aliases)
     opts = {"abstol": atol, "reltol": rtol, "max_num_steps": max_steps,
             "calc_ic": False}   # initialize() already made x0, z0 consistent
@@ -87,13 +144,15 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
     names = [dae.names[k] for k in obs_idx]
     flat = compiled.reduced.model
     units = {v.name: v.decl.unit for v in flat.variables}
-    params_out = {q.name: float(val) for q, val in zip(dae.parameters, p, strict=False)}
+    units.update({q.name: q.decl.unit for q in (*flat.parameters, *flat.inputs)})
+    params_out = dae.parameter_values(p)
     meta = {"compile_seconds": compiled.compile_time, "run_seconds": run,
             "timings": dict(compiled.timings), "solver": solver, "stats": stats,
             "states": list(dae.state_names), "init_notes": init.notes}
     kept = set(names)
     aliases = {a: rep for a, rep in flat.aliases.items() if rep[0] in kept}
     result = Result(grid[:n_ok], values, names, aliases, params_out, units, meta)
+    check_result(result, dae, p)
     if failure is not None:
         t_reached = float(grid[n_ok - 1]) if n_ok else start_time
         hint = next((h for key, h in _HINTS.items() if key in failure), "see the solver message")

@@ -239,7 +239,7 @@ class CurrentSensor(Component):
 #     v = s*(if off then 1 else Ron) [+ Vknee],    i = s*(if off then Goff else 1) [+ Goff*Vknee].
 # ``off`` changes only at events: a zero crossing of a relation (diode, controlled switches) or
 # a change of the Boolean control signal. Units of s: V while off, A while on (MSL multiplies by
-# constants of 1 V / 1 A; here s carries unit "1").
+# constants of 1 V / 1 A; here s declares no unit, "", so the unit check lets it take both).
 
 
 class IdealSemiconductor(OnePort):
@@ -259,7 +259,7 @@ class IdealSemiconductor(OnePort):
     current's error (up to ~rtol*10 V/Ron) can reach zero before the real turn-off and cause
     spurious off/on event pairs.
     Parameters: Ron [Ohm] (>= 0), Goff [S] (>= 0), Vknee [V] (>= 0).
-    Variables: s [1] (auxiliary); Boolean ``off`` (start true).
+    Variables: s (auxiliary, V or A: no declared unit); Boolean ``off`` (start true).
     """
 
     Ron = Parameter(1e-5, unit="Ohm", min=0.0, description="Forward state-on differential "
@@ -268,7 +268,7 @@ class IdealSemiconductor(OnePort):
                      "(opened conductance)")
     Vknee = Parameter(0.0, unit="V", min=0.0, description="Forward threshold voltage")
     off = Boolean(start=True, description="Switching state (true: blocking)")
-    s = Variable(unit="1", start=0.0, description="Auxiliary variable for the characteristic: "
+    s = Variable(unit="", start=0.0, description="Auxiliary variable for the characteristic: "
                  "actual current if conducting, actual voltage if blocking (minus Vknee)")
 
     def equations(self):
@@ -283,7 +283,7 @@ class IdealDiode(IdealSemiconductor):
     (v < Vknee). Pins: p (anode), n (cathode).
 
     Parameters: Ron [Ohm] = 1e-5, Goff [S] = 1e-5, Vknee [V] = 0.
-    Variables: v [V], i [A] (p -> n), s [1]; Boolean ``off``. See :class:`IdealSemiconductor`.
+    Variables: v [V], i [A] (p -> n), s (no unit); Boolean ``off``. See :class:`IdealSemiconductor`.
     """
 
 
@@ -294,13 +294,13 @@ class IdealSwitch(OnePort):
 
     closed (``off`` false): a resistance Ron; open (``off`` true): a conductance Goff.
     A subclass defines the Boolean ``off``.
-    Parameters: Ron [Ohm] (>= 0), Goff [S] (>= 0). Variables: s [1]; Boolean ``off``.
+    Parameters: Ron [Ohm] (>= 0), Goff [S] (>= 0). Variables: s (no unit); Boolean ``off``.
     """
 
     Ron = Parameter(1e-5, unit="Ohm", min=0.0, description="Closed switch resistance")
     Goff = Parameter(1e-5, unit="S", min=0.0, description="Opened switch conductance")
     off = Boolean(start=False, description="Switch state (true: open)")
-    s = Variable(unit="1", start=0.0, description="Auxiliary variable: current if closed, "
+    s = Variable(unit="", start=0.0, description="Auxiliary variable: current if closed, "
                  "voltage if open")
 
     def equations(self):
@@ -356,8 +356,8 @@ class PartialCommutingSwitch(Component):
     p = Pin()
     n1 = Pin()
     n2 = Pin()
-    s1 = Variable(unit="1", start=0.0, description="Auxiliary variable of the p--n1 path")
-    s2 = Variable(unit="1", start=0.0, description="Auxiliary variable of the p--n2 path")
+    s1 = Variable(unit="", start=0.0, description="Auxiliary variable of the p--n1 path")
+    s2 = Variable(unit="", start=0.0, description="Auxiliary variable of the p--n2 path")
 
     def switched(self, to_n2):
         """The switch equations with ``to_n2`` (true: p--n2 connected, p--n1 open)."""

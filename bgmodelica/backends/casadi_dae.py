@@ -14,7 +14,7 @@ import numpy as np
 
 from ..core.flatmodel import FlatVariable, HybridPart
 from ..core.variables import TIME
-from ..errors import ParameterError
+from ..errors import ParameterError, UnitError
 from ..passes.sorting import SortedDAE
 
 
@@ -46,9 +46,34 @@ class CasadiDAE:
     discretes: list[FlatVariable] = field(default_factory=list)  # slots at the end of p
     hybrid: HybridPart | None = None      # SX in terms of t, x, z, p
     n_variables: int = 0                  # names[:n_variables] are continuous-time variables
+    bound: list[FlatVariable] = field(default_factory=list)   # parameters bound to others
     discrete_names: set[str] = field(default_factory=set)     # discrete-valued variables
     differentiated: set[str] = field(default_factory=set)     # variables x with der(x)
     aliases: dict[str, tuple[str, float]] = field(default_factory=dict)
+    #: the SortedDAE it was built from (names the equations in diagnostics)
+    sorted: object = field(default=None, repr=False, compare=False)
+    #: Modelica initial equations as residuals in (t, x, z, p) and their descriptions
+    #: (``initial equation TEXT [component]``); see :func:`attach_initial_equations`
+    initial: ca.SX = field(default_factory=lambda: ca.SX(0, 1))
+    initial_labels: list[str] = field(default_factory=list)
+
+    def parameter_values(self, p: np.ndarray) -> dict[str, float]:
+        """Every parameter's value for the vector ``p``, bound ones included."""
+        out = {q.name: float(v) for q, v in zip(self.parameters, p, strict=False)}
+        if self.bound:
+            if "bound_values" not in self.cache:
+                free = ca.vertcat(*[q.sx for q in self.parameters]) if self.parameters \
+                    else ca.SX(0, 1)
+                expr = ca.vertcat(*[ca.SX(q.decl.value) for q in self.bound])
+                for _ in range(len(self.bound)):       # bindings may chain
+                    syms = [q.sx for q in self.bound]
+                    if not ca.depends_on(expr, ca.vertcat(*syms)):
+                        break
+                    expr = ca.substitute(expr, ca.vertcat(*syms), expr)
+                self.cache["bound_values"] = ca.Function("bound", [free], [expr])
+            vals = np.asarray(self.cache["bound_values"](p[:len(self.parameters)])).ravel()
+            out.update({q.name: float(v) for q, v in zip(self.bound, vals, strict=True)})
+        return out
 
     @property
     def n_base(self) -> int:
@@ -69,17 +94,27 @@ class CasadiDAE:
             names = [p.name for p in self.parameters] + [u.name for u in self.inputs] \
                 + [d.name for d in self.discretes]
             where = {n: k for k, n in enumerate(names)}
+            units = [v.decl.unit for v in (*self.parameters, *self.inputs, *self.discretes)]
             for key, value in overrides.items():
                 if key not in where:
                     close = [n for n in names if n.split(".")[-1] == key.split(".")[-1]]
                     hint = f"; did you mean {', '.join(close[:5])}?" if close else ""
                     raise ParameterError(f"{key!r} is not a parameter or input of the "
                                          f"model{hint}")
-                vec[where[key]] = _number(key, value)
+                vec[where[key]] = _number(key, value, units[where[key]])
         return vec
 
 
-def _number(name: str, value: object) -> float:
+def _number(name: str, value: object, unit: str | None = None) -> float:
+    """``value`` as a finite float; a string with a unit (``"2 kOhm"``) is converted to
+    ``unit``, the declared unit of ``name``."""
+    if isinstance(value, str):
+        from ..core.units import quantity_value
+
+        try:
+            value = quantity_value(name, value, unit)
+        except ValueError as err:
+            raise UnitError(str(err)) from None
     try:
         out = float(value)  # type: ignore[arg-type]
     except (TypeError, ValueError):
@@ -148,11 +183,38 @@ def build_dae(sorted_dae: SortedDAE) -> CasadiDAE:
         x_start=np.array([_start(variables[j]) for j in states], dtype=float),
         z_start=np.array([_start(variables[j]) for j in alg_vars], dtype=float),
         fixed=fixed, observed_index=observed_index, discretes=list(model.discretes),
-        hybrid=hybrid, n_variables=len(variables),
+        hybrid=hybrid, n_variables=len(variables), bound=bound,
         discrete_names={v.name for v in variables if v.decl.kind == "discrete"}
         | {d.name for d in shown},
-        differentiated={v.name for v in variables if v.der >= 0}, aliases=dict(model.aliases))
+        differentiated={v.name for v in variables if v.der >= 0}, aliases=dict(model.aliases),
+        sorted=sorted_dae)
 
 
 def _start(v: FlatVariable) -> float:
     return float(getattr(v.decl, "start", 0.0))
+
+
+def attach_initial_equations(dae: CasadiDAE, model) -> None:
+    """Set ``dae.initial`` from ``model.initial_equations`` (a :class:`FlatModel` after alias
+    elimination, or the index-reduced one: both hold the same variable symbols): every
+    variable is replaced by its observation in (t, x, z, p), bound parameters by their
+    values."""
+    eqs = getattr(model, "initial_equations", None) or []
+    if not eqs:
+        return
+    res = ca.vertcat(*[e.residual for e in eqs])
+    n_var = dae.n_variables or len(dae.names)
+    vsyms = [v.sx for v in dae.sorted.model.variables] if dae.sorted is not None else []
+    if len(vsyms) != n_var:
+        raise RuntimeError("initial equations: variables and observations do not match")
+    obs = dae.observed[:n_var]
+    res = ca.substitute([res], [ca.vertcat(*vsyms)], [obs])[0] if vsyms else res
+    if dae.bound:
+        for _ in range(len(dae.bound)):               # bindings may chain
+            bsym = ca.vertcat(*[q.sx for q in dae.bound])
+            if not ca.depends_on(res, bsym):
+                break
+            res = ca.substitute(res, bsym, ca.vertcat(*[ca.SX(q.decl.value) for q in dae.bound]))
+    dae.initial = res
+    dae.initial_labels = [e.origin for e in eqs]
+

@@ -31,17 +31,31 @@ class InitStructure:
     """Which states the initial conditions determine (independent of parameter values).
 
     x0: start values with the fixed states set; free: indices of the states solved together
-    with z from ``conditions`` ``(observed index, value)``; notes: states left at their start
-    values."""
+    with z from ``conditions`` ``(observed index, value)`` and the model's ``n_initial``
+    initial equations (``dae.initial``); notes: states left at their start values."""
 
     x0: np.ndarray
     free: list[int]
     conditions: list[tuple[int, float]]
     notes: list[str]
+    n_initial: int = 0
+
+    def labels(self, dae: CasadiDAE) -> list[str]:
+        """What each condition row is: a fixed start value or an initial equation."""
+        out = [f"fixed start value {dae.names[k]} = {v:g}" for k, v in self.conditions]
+        given = list(getattr(dae, "initial_labels", None) or [])
+        return out + [given[i] if i < len(given) else f"initial equation {i}"
+                      for i in range(self.n_initial)]
+
+
+def _n_initial(dae: CasadiDAE) -> int:
+    initial = getattr(dae, "initial", None)
+    return int(initial.numel()) if initial is not None else 0
 
 
 def init_structure(dae: CasadiDAE) -> InitStructure:
-    """Match the fixed start values to the states (raise when they over-determine them)."""
+    """Match the fixed start values and initial equations to the states (raise
+    :class:`InitializationError` naming them when they over-determine them)."""
     state_pos = {n: k for k, n in enumerate(dae.state_names)}
     x0 = dae.x_start.copy()
     fixed_states = set()
@@ -53,49 +67,52 @@ def init_structure(dae: CasadiDAE) -> InitStructure:
             fixed_states.add(state_pos[name])
         else:
             conditions.append((k, value))
+    n_init = _n_initial(dae)
+    st = InitStructure(x0, [], conditions, [], n_init)
     free = [i for i in range(len(x0)) if i not in fixed_states]
-    notes: list[str] = []
     nz = dae.z.numel()
-    if conditions:
-        cond_expr = ca.vertcat(*[dae.observed[k] for k, _ in conditions])
+    exprs = [dae.observed[k] for k, _ in conditions] + [dae.initial[i] for i in range(n_init)]
+    if exprs:
         xf = ca.vertcat(*[dae.x[i] for i in free]) if free else ca.SX(0, 1)
-        sp = ca.jacobian_sparsity(ca.vertcat(dae.alg, cond_expr),
+        sp = ca.jacobian_sparsity(ca.vertcat(dae.alg, *exprs),
                                   ca.vertcat(xf, dae.z)) if free or nz else None
-        rows: list[list[int]] = [[] for _ in range(nz + len(conditions))]
+        rows: list[list[int]] = [[] for _ in range(nz + len(exprs))]
         if sp is not None:
             for r, c in zip(*sp.get_triplet(), strict=True):
                 rows[r].append(c)
-        # the model's own equations first: conditions compete for what they leave free
-        first = maximum_matching(rows[:nz] + [[] for _ in conditions], len(free) + nz)
-        match = maximum_matching(rows, len(free) + nz, initial=first)
-        surplus = [conditions[i][0] for i in range(len(conditions))
-                   if match.eq_to_var[nz + i] < 0]
+        # the model's own equations first, on the algebraic variables they determine (so
+        # that every algebraic variable stays matched): conditions compete for the rest
+        nf = len(free)
+        first = maximum_matching([[c for c in r if c >= nf] for r in rows[:nz]]
+                                 + [[] for _ in exprs], nf + nz)
+        match = maximum_matching(rows, nf + nz, initial=first)
+        surplus = [i for i in range(len(exprs)) if match.eq_to_var[nz + i] < 0]
         if surplus:
-            names = ", ".join(dae.names[k] for k in surplus)
-            raise InitializationError(
-                f"the initial conditions are over-determined: fixed start values of {names} "
-                f"cannot be met independently (states: {', '.join(dae.state_names)}). "
-                "Set fixed=False on these or on the states they conflict with")
-        unmatched = [free[c] for c in range(len(free)) if match.var_to_eq[c] < 0]
+            labelled = list(zip(exprs, st.labels(dae), strict=True))
+            raise InitializationError(_overdetermined(dae, labelled, surplus, rows, match,
+                                                      free, fixed_states))
+        unmatched = [free[c] for c in range(nf) if match.var_to_eq[c] < 0]
     else:
         unmatched = list(free)
     if unmatched:
-        notes.append("no fixed start value for state(s) "
-                     + ", ".join(dae.state_names[i] for i in unmatched)
-                     + "; their start values were used")
+        st.notes.append("no fixed start value or initial equation for state(s) "
+                        + ", ".join(dae.state_names[i] for i in unmatched)
+                        + "; their start values were used")
         free = [i for i in free if i not in set(unmatched)]
-    return InitStructure(x0, free, conditions, notes)
+    st.free = free
+    return st
 
 
 def _init_residual(dae: CasadiDAE, st: InitStructure) -> ca.Function:
-    """``g(w, [x_pinned, p, t])``: conditions and algebraic equations, w = [x_free, z]."""
+    """``g(w, [x_pinned, p, t])``: conditions, initial equations and algebraic equations,
+    w = [x_free, z]."""
     unknown = ca.vertcat(*[dae.x[i] for i in st.free], dae.z)
-    cond = ca.vertcat(*[dae.observed[k] - v for k, v in st.conditions]) if st.conditions \
-        else ca.SX(0, 1)
+    cond = [dae.observed[k] - v for k, v in st.conditions] \
+        + [dae.initial[i] for i in range(st.n_initial)]
     pinned = [i for i in range(len(st.x0)) if i not in set(st.free)]
     known = ca.vertcat(*[dae.x[i] for i in pinned]) if pinned else ca.SX(0, 1)
     return ca.Function("init_g", [unknown, ca.vertcat(known, dae.p, dae.t)],
-                       [ca.vertcat(cond, dae.alg)])
+                       [ca.vertcat(*cond, dae.alg)])
 
 
 def initial_state_function(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
@@ -105,7 +122,7 @@ def initial_state_function(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
     follow their parameters as native simulation does; None when the initial state is fixed
     (no conditions through the model's equations)."""
     st = init_structure(dae)
-    if not st.conditions:
+    if not st.conditions and not st.n_initial:
         return None
     sol = initialize(dae, p, t0)
     g = _init_residual(dae, st)
@@ -125,13 +142,19 @@ def initial_state_function(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
 
 def initialize(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
                tol: float = 1e-10) -> InitialValues:
-    """Solve the initial-value problem at ``t0`` for parameter vector ``p``."""
+    """Solve the initial-value problem at ``t0`` for parameter vector ``p``.
+
+    The conditions are the fixed start values and the model's initial equations
+    (``dae.initial``, Modelica ``initial equation``), together with the algebraic equations;
+    they must determine the states independently (balance checked by a matching: conditions
+    left unmatched raise :class:`InitializationError` naming them and the variables they
+    compete for); states without a condition keep their start values (a note)."""
     st = init_structure(dae)
-    x0, free, conditions, notes = st.x0.copy(), st.free, st.conditions, list(st.notes)
-    nz = dae.z.numel()
+    x0, free = st.x0, st.free
     z0 = dae.z_start.copy()
-    if not conditions and nz == 0:
-        return InitialValues(x0, z0, notes)
+    n_cond = len(st.conditions) + st.n_initial
+    if not n_cond and dae.z.numel() == 0:
+        return InitialValues(x0, z0, list(st.notes))
     guess = np.concatenate([x0[free], z0])
     pinned = [i for i in range(len(x0)) if i not in set(free)]
     g = _init_residual(dae, st)
@@ -143,13 +166,51 @@ def initialize(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
         sol = np.asarray(solver(guess, args)).ravel()
         r1 = np.asarray(g(sol, args)).ravel()
         if not np.all(np.isfinite(r1)) or np.max(np.abs(r1)) > max(1e3 * tol, 1e-8):
-            worst = int(np.argmax(np.abs(r1)))
-            what = (dae.names[conditions[worst][0]] if worst < len(conditions)
-                    else dae.algebraic_names[worst - len(conditions)])
+            with np.errstate(invalid="ignore"):
+                worst = int(np.argmax(np.where(np.isfinite(r1), np.abs(r1), np.inf)))
+            labels = st.labels(dae)
+            what = (labels[worst] if worst < n_cond
+                    else dae.algebraic_names[worst - n_cond])
+            size = np.max(np.abs(r1)) if np.all(np.isfinite(r1)) else np.nan
+            hint = ("; the initial equations or fixed start values may contradict each other "
+                    "or the model" if st.n_initial else "")
             raise InitializationError(
-                f"initialization did not converge: residual {np.max(np.abs(r1)):.3g} at "
-                f"{what}; give better start values (guesses) for the algebraic variables")
+                f"initialization did not converge: residual {size:.3g} at "
+                f"{what}; give better start values (guesses) for the algebraic variables"
+                + hint)
         guess = sol
     x0[free] = guess[:len(free)]
     z0 = guess[len(free):]
-    return InitialValues(x0, z0, notes)
+    return InitialValues(x0, z0, list(st.notes))
+
+
+def _overdetermined(dae: CasadiDAE, conditions: list[tuple[ca.SX, str]], surplus: list[int],
+                    rows: list[list[int]], match, free: list[int], fixed_states: set[int]
+                    ) -> str:
+    """The message for conditions that over-determine the initial values: the surplus
+    conditions, the other conditions they compete with and the variables involved (the
+    over-determined part of the Dulmage-Mendelsohn decomposition)."""
+    from ..structure.diagnosis import dulmage_mendelsohn
+
+    nz = dae.z.numel()
+    unknown_names = [dae.state_names[i] for i in free] + list(dae.algebraic_names)
+    dm = dulmage_mendelsohn(rows, len(free) + nz, match)
+    involved = [conditions[e - nz][1] for e in dm.overdetermined_eqs
+                if e >= nz and e - nz not in surplus]
+    variables = [unknown_names[v] for v in dm.overdetermined_vars]
+    pinned = [dae.state_names[i] for i in sorted(fixed_states)
+              if any(ca.depends_on(conditions[s][0], dae.x[i]) for s in surplus)]
+    variables += [f"{n} (fixed start value)" for n in pinned]
+    fixed_starts = [conditions[s][1] for s in surplus if conditions[s][1].startswith("fixed")]
+    text = ("the initial conditions are over-determined: "
+            + "; ".join(conditions[s][1] for s in surplus)
+            + (f" -- competing with {'; '.join(involved)}" if involved else "")
+            + (f" -- for {', '.join(variables)}" if variables else " -- it depends on no "
+               "free state or algebraic variable")
+            + f" (states: {', '.join(dae.state_names) or 'none'}). ")
+    if fixed_starts:
+        text += "Set fixed=False on these or on the states they conflict with"
+    else:
+        text += ("Remove one of the conflicting initial equations, or set fixed=False on the "
+                 "start values they conflict with")
+    return text

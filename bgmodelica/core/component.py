@@ -79,7 +79,7 @@ class Element:
             self._symbols[key] = sym
             object.__setattr__(self, key, sym.leaf)
         for key, template in type(self)._templates.items():
-            child = template.clone()
+            child = _build_child(key, template)
             if key in local:
                 child.modify(**_as_modifiers(key, local.pop(key)))
             self.add(key, child)
@@ -154,6 +154,22 @@ class Element:
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self._name or ''})"
+
+
+def _build_child(key: str, template: Element) -> Element:
+    """``template.clone()``; an exception of user code names the subcomponent path."""
+    from ..errors import ModelError, UserCodeError
+    from ..validate import nested_user_error, user_error
+
+    try:
+        return template.clone()
+    except UserCodeError as err:
+        raise nested_user_error(err, key, type(template).__name__) from err.__cause__
+    except ModelError:
+        raise
+    except Exception as err:  # noqa: BLE001 -- user code: say where, no traceback
+        raise nested_user_error(user_error(err, f"{type(template).__name__}()"), key,
+                                type(template).__name__) from err
 
 
 def _as_modifiers(name: str, value: Any) -> dict[str, Any]:
@@ -241,7 +257,13 @@ def check_connectable(a: Any, b: Any) -> None:
             f"cannot connect {_describe(a)} to {_describe(b)}: only connectors or causal "
             "signals (Input/Output) can be connected; connect the connectors that hold them")
     if kinds == {KIND_OUTPUT}:
-        raise ConnectError(f"cannot connect two outputs: {syms[0].name} and {syms[1].name}")
+        raise ConnectError(f"cannot connect two outputs: {_qualified(syms[0])} and "
+                           f"{_qualified(syms[1])} (an output is connected to inputs)")
+
+
+def _qualified(sym: Symbol) -> str:
+    owner = getattr(sym.owner, "name", None)
+    return f"{owner}.{sym.name}" if owner else sym.name
 
 
 class Component(Element):
@@ -250,6 +272,36 @@ class Component(Element):
     def equations(self) -> Iterable[Any]:
         """Yield this class's own equations ``lhs == rhs`` and ``connect(a, b)`` statements."""
         return ()
+
+    def _repr_html_(self) -> str:
+        """Jupyter view: parameters with units, balance, bond-graph drawing
+        (:func:`bgmodelica.notebook.component_html`)."""
+        from ..notebook import component_html
+
+        return component_html(self)
+
+    def initial_equations(self) -> Iterable[Any]:
+        """Yield this class's own *initial equations* ``lhs == rhs`` (Modelica ``initial
+        equation``): conditions that hold at the start time only, e.g. ``der(self.x) == 0``
+        (start at rest) or ``self.y == self.y0`` (an algebraic variable's initial value).
+        They join the fixed start values in the initialization (see
+        :mod:`bgmodelica.backends.casadi_init`); inherited like :meth:`equations`."""
+        return ()
+
+    def initial_equation(self, *eqs: Any) -> None:
+        """Imperative form: add initial equations ``lhs == rhs`` to this component."""
+        self.__dict__.setdefault("_initial_equations", []).extend(eqs)
+
+    def all_initial_equations(self) -> Iterator[Any]:
+        """Initial equations of every class in the hierarchy (base classes first), then
+        added ones."""
+        for cls in reversed(type(self).__mro__):
+            own = vars(cls).get("initial_equations")
+            if own is not None:
+                result = own(self)
+                if result is not None:
+                    yield from result
+        yield from self.__dict__.get("_initial_equations", ())
 
     def connect(self, a: Any, b: Any) -> None:
         """Imperative form of ``connect`` for models assembled in code."""

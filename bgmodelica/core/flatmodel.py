@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import casadi as ca
 
@@ -62,6 +63,25 @@ class FlatEquation:
 
 
 @dataclass
+class EquationSources:
+    """The equations as the user wrote them (expression trees), for passes that read them
+    (unit checking, :mod:`bgmodelica.passes.units`).
+
+    groups: equation shape -> members ``(leaf symbols, constants, origin, Equation)``, as
+    flattening grouped them. draft: the hybrid part (relations, when-clauses, clocks), a
+    :class:`~bgmodelica.core.flatten_hybrid.HybridDraft` or None. bindings: parameters bound to
+    expressions ``(dotted name, declaration, origin)``. links: connected signals ``(a, b,
+    origin)``. initial: initial equations ``(Equation, origin)``.
+    """
+
+    groups: dict[Any, list] = field(default_factory=dict)
+    draft: Any = None
+    bindings: list[tuple[str, Any, str]] = field(default_factory=list)
+    links: list[tuple[Any, Any, str]] = field(default_factory=list)
+    initial: list[tuple[Any, str]] = field(default_factory=list)
+
+
+@dataclass
 class FlatModel:
     """Variables, parameters, inputs and equations of a flattened model.
 
@@ -77,6 +97,12 @@ class FlatModel:
     aliases: dict[str, tuple[str, float]] = field(default_factory=dict)
     discretes: list[FlatVariable] = field(default_factory=list)
     hybrid: HybridPart | None = None
+    #: the equations as written (set by flattening, dropped by later passes)
+    sources: EquationSources | None = field(default=None, repr=False, compare=False)
+    #: Modelica ``initial equation``s: residuals that hold at the start time only (their
+    #: origin reads ``initial equation TEXT [component]``); carried to
+    #: :attr:`bgmodelica.backends.casadi_dae.CasadiDAE.initial` by the compiler
+    initial_equations: list[FlatEquation] = field(default_factory=list)
 
     def index(self) -> dict[str, int]:
         """Name -> index in :attr:`variables`."""

@@ -18,10 +18,11 @@ from typing import Any
 import casadi as ca
 
 from ..errors import ConnectError, DeclarationError, EquationError
+from ..validate import check_binding, check_sx_binding, guarded_equations
 from . import flatten_hybrid
 from .component import Component, Connection, Connector, Element
 from .expr import HYBRID_NODES, Equation, Expr, Leaf, Number, lower_group, shape_of, to_sx
-from .flatmodel import FlatEquation, FlatModel, FlatVariable
+from .flatmodel import EquationSources, FlatEquation, FlatModel, FlatVariable
 from .variables import (
     KIND_FLOW,
     KIND_INPUT,
@@ -53,6 +54,8 @@ class _Flattener:
         self.draft: flatten_hybrid.HybridDraft | None = None
         self.slot: dict[int, int] = {}            # id(Symbol) -> index in discretes
         self.full: dict[int, str] = {}            # id(Symbol) -> dotted name
+        self.groups: dict[Any, list] = {}         # equation shape -> members (as written)
+        self.initial_sources: list[tuple[Equation, str]] = []   # initial equations as written
 
     # -- tree walk -------------------------------------------------------------------------
     def run(self, name: str) -> FlatModel:
@@ -68,7 +71,7 @@ class _Flattener:
                 self.parents[id(elem)] = parent
             self.elements.append(elem)
             if isinstance(elem, Component):
-                for eq in elem.all_equations():
+                for eq in guarded_equations(elem, self.where(elem), path):
                     if isinstance(eq, Connection):
                         self.connections.append((eq, elem))
                     else:
@@ -82,13 +85,70 @@ class _Flattener:
         self._bind(symbols)
         self._connection_equations()
         self._component_equations()
+        initial = self._initial_equations()
+        sources = self._sources(parameters)
         parameters = [self._lower_binding(p) for p in parameters]
         hybrid = None
         if self.draft is not None:
             hybrid = flatten_hybrid.lower(self.draft, lambda s: self.slot[id(s)],
                                           lambda s: self.full[id(s)])
         return FlatModel(name, variables, parameters, inputs, self.equations,
-                         discretes=discretes, hybrid=hybrid)
+                         discretes=discretes, hybrid=hybrid, sources=sources,
+                         initial_equations=initial)
+
+    def _initial_equations(self) -> list[FlatEquation]:
+        """Lower the components' ``initial_equations()`` (Modelica ``initial equation``) to
+        residuals in the model's symbols; the origin reads ``initial equation TEXT [where]``."""
+        from ..validate import user_error
+
+        out: list[FlatEquation] = []
+        known = None
+        for elem in self.elements:
+            if not isinstance(elem, Component):
+                continue
+            where = self.where(elem)
+            try:
+                eqs = list(elem.all_initial_equations())
+            except (ConnectError, DeclarationError, EquationError):
+                raise
+            except Exception as err:  # noqa: BLE001 -- user code: say where, no traceback
+                raise user_error(err, f"{where}: initial_equations()",
+                                 self.paths[id(elem)]) from None
+            for eq in eqs:
+                if isinstance(eq, Equation):
+                    text = repr(eq)
+                    res = ca.SX(to_sx(eq.lhs) - to_sx(eq.rhs))
+                    self.initial_sources.append((eq, where))
+                elif isinstance(eq, ca.SX) and eq.numel() == 1 and eq.is_op(ca.OP_EQ):
+                    text = f"{eq.dep(0)} == {eq.dep(1)}"
+                    res = eq.dep(0) - eq.dep(1)
+                else:
+                    raise EquationError(f"{where}: an initial equation must be written "
+                                        f"'lhs == rhs', got {eq!r}")
+                if known is None:
+                    known = {x.element_hash() for x in ca.vertsplit(self.all_sx)}
+                alien = [x for x in ca.symvar(res) if x.element_hash() not in known]
+                if alien:
+                    sym = lookup(alien[0])
+                    what = str(alien[0])
+                    hint = ""
+                    if sym is not None and sym.der_of is not None:
+                        hint = (f" ({sym.der_of.name} is not differentiated by the model's "
+                                "equations, so its derivative is no variable of the model)")
+                    raise EquationError(f"{where}: initial equation {text} uses {what}, which "
+                                        f"is not part of the model{hint}")
+                if not ca.symvar(res):
+                    raise EquationError(f"{where}: initial equation {text} has no variables")
+                out.append(FlatEquation(res, f"initial equation {text}   [{where}]"))
+        return out
+
+    def _sources(self, parameters: list[FlatVariable]) -> EquationSources:
+        """The equations as written, for passes that read expression trees (units)."""
+        bindings = [(p.name, p.decl, f"{p.component or 'top level'}") for p in parameters
+                    if isinstance(p.decl.value, Expr)]
+        links = [(c.a, c.b, self.where(ctx)) for c, ctx in self.connections
+                 if not isinstance(c.a, Connector)]
+        return EquationSources(self.groups, self.draft, bindings, links, self.initial_sources)
 
     def where(self, elem: Element) -> str:
         return f"{self.paths[id(elem)] or 'top level'} ({type(elem).__name__})"
@@ -164,12 +224,16 @@ class _Flattener:
 
     def _lower_binding(self, p: FlatVariable) -> FlatVariable:
         if isinstance(p.decl.value, Expr):
-            for leaf_sym in _leaf_symbols(p.decl.value):
+            leaves = _leaf_symbols(p.decl.value)
+            for leaf_sym in leaves:
                 if id(leaf_sym) not in self.pos:
                     raise DeclarationError(
                         f"parameter {p.name} is bound to {p.decl.value!r}, which uses "
                         f"{getattr(leaf_sym, 'name', leaf_sym)}: not part of this model")
+            check_binding(p.name, p.decl.value, leaves, self.full)   # parameters only
             return replace(p, decl=replace(p.decl, value=to_sx(p.decl.value)))
+        if isinstance(p.decl.value, ca.SX):
+            check_sx_binding(p.name, p.decl.value)
         if not isinstance(p.decl.value, (Number, ca.SX)):
             raise DeclarationError(f"parameter {p.name} has a non-numeric value "
                                    f"{p.decl.value!r}")
@@ -191,6 +255,12 @@ class _Flattener:
         connectors: dict[int, Connector] = {}
         signal_links: list[tuple[Any, Any, Component]] = []
         for conn, ctx in self.connections:
+            if conn.a is conn.b or (not isinstance(conn.a, Connector)
+                                    and _symbol(conn.a) is _symbol(conn.b)):
+                end = self.paths.get(id(conn.a)) if isinstance(conn.a, Connector) \
+                    else self.full.get(id(_symbol(conn.a)), "?")
+                raise ConnectError(f"{self.where(ctx)}: connect({end}, {end}) connects {end} "
+                                   "to itself")
             ends = []
             for end in (conn.a, conn.b):
                 if isinstance(end, Connector):
@@ -296,6 +366,7 @@ class _Flattener:
                 raise EquationError(
                     f"{where}: an equation must be written 'lhs == rhs' with at least one "
                     f"variable, got {eq!r}")
+        self.groups = groups
         for key, members in groups.items():
             self._lower(key, members)
         if slow:

@@ -8,6 +8,7 @@ Modules:
 - :mod:`.ssp`: SSP 1.0 archives -- :func:`write_ssp`, :func:`read_ssp`,
   :func:`system_from_fmus`, :class:`SystemStructure`;
 - :mod:`.fmu`: FMU model descriptions and fmpy-based Co-Simulation / Model Exchange units;
+- :mod:`.archive`: safe reading and extraction of FMU/SSP zip archives (:class:`SafeZip`);
 - :mod:`.checks`: set-up checks (unconnected inputs, type/unit mismatches, algebraic loops);
 - :mod:`.master`: :class:`Master` / :func:`cosimulate` -- fixed macro step, Jacobi or
   Gauss-Seidel, optional linear extrapolation, feedthrough propagation;
@@ -18,15 +19,22 @@ Modules:
 Errors are :class:`bgmodelica.errors.ModelError` subclasses (:mod:`.errors`).
 """
 
+from .archive import SafeZip
 from .errors import (
     AlgebraicLoopError,
+    ArchiveError,
     ConnectorMismatchError,
     CosimError,
     CosimStepError,
+    DuplicateElementError,
+    FmuFormatError,
+    InvalidExperimentError,
+    InvalidParameterError,
     SetupError,
     SspFormatError,
     UnconnectedInputError,
     UnknownConnectorError,
+    UnsafeArchiveError,
 )
 from .master import Master, cosimulate
 from .ssp import (
@@ -42,8 +50,10 @@ from .verify import VerifyReport, verify_robot
 from .wrap import FlowInput, FlowOutput, PotentialInput, PotentialOutput, add_signal, expose
 
 __all__ = [
-    "AlgebraicLoopError", "ConnectorMismatchError", "CosimError", "CosimStepError",
-    "SetupError", "SspFormatError", "UnconnectedInputError", "UnknownConnectorError",
+    "AlgebraicLoopError", "ArchiveError", "ConnectorMismatchError", "CosimError",
+    "CosimStepError", "DuplicateElementError", "FmuFormatError", "InvalidExperimentError",
+    "InvalidParameterError", "SafeZip", "SetupError", "SspFormatError",
+    "UnconnectedInputError", "UnknownConnectorError", "UnsafeArchiveError",
     "Master", "cosimulate", "SspComponent", "SspConnection", "SspConnector",
     "SystemStructure", "read_ssp", "system_from_fmus", "write_ssp", "VerifyReport",
     "verify_robot", "FlowInput", "FlowOutput", "PotentialInput", "PotentialOutput",

@@ -3,6 +3,10 @@ graph that orders the evaluation of outputs at a communication point.
 
 :func:`check_system` raises (all :class:`~bgmodelica.errors.ModelError`):
 
+* :class:`~.errors.DuplicateElementError` -- two elements with one name (or no element);
+* :class:`~.errors.InvalidParameterError` -- a parameter binding that is not finite, lies
+  outside the ``[min, max]`` the FMU declares, or sets something that cannot be set (a
+  constant, a calculated parameter, an output, a local, a non-real variable);
 * :class:`~.errors.UnknownConnectorError` -- a connection or parameter binding names an
   element, connector or parameter that does not exist;
 * :class:`~.errors.ConnectorMismatchError` -- a connection from something that is not an
@@ -17,16 +21,20 @@ graph that orders the evaluation of outputs at a communication point.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from ..fmi.units import parse_unit
 from .errors import (
     AlgebraicLoopError,
     ConnectorMismatchError,
+    DuplicateElementError,
+    InvalidParameterError,
+    SetupError,
     UnconnectedInputError,
     UnknownConnectorError,
 )
-from .fmu import FmuInfo
+from .fmu import FmuInfo, FmuVariable
 from .ssp import SystemStructure
 
 
@@ -60,16 +68,53 @@ def units_compatible(a: str, b: str) -> bool:
             and da.offset == db.offset)
 
 
+def check_parameter_value(element: str, info: FmuInfo, name: str, value: object,
+                          what: str = "parameter binding", unit: str = "") -> float:
+    """Check that ``element.name = value`` can be set before initialization of the FMU
+    ``info`` (exists, settable real parameter or input, finite, in ``[min, max]``, ``unit``
+    compatible); return the value as a float."""
+    var: FmuVariable | None = info.variables.get(name)
+    where = f"{what} {element}.{name}"
+    if var is None:
+        raise UnknownConnectorError(f"{where}: {info.path.name} has no variable {name!r}")
+    if not var.settable or var.type != "Real":
+        raise InvalidParameterError(
+            f"{where}: it is a {var.variability} {var.causality} {var.type} of "
+            f"{info.path.name}, not a real parameter that can be set (only tunable or fixed "
+            "parameters and the start values of inputs can)")
+    try:
+        x = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise InvalidParameterError(f"{where}: {value!r} is not a number") from None
+    if not math.isfinite(x):
+        raise InvalidParameterError(f"{where}: the value {x} is not finite")
+    if var.out_of_range(x):
+        raise InvalidParameterError(f"{where} = {x:g} is outside the range "
+                                    f"{var.range_text()} declared in {info.path.name}")
+    if unit and not units_compatible(unit, var.unit):
+        raise ConnectorMismatchError(f"{where} is given in {unit!r} but {name} is in "
+                                     f"{var.unit!r} in {info.path.name}")
+    return x
+
+
 def check_system(system: SystemStructure, infos: dict[str, FmuInfo],
                  allow_unconnected: bool = False) -> Plan:
     """Check ``system`` against the FMUs (``infos``: element -> :class:`FmuInfo`); return the
     :class:`Plan` or raise (see the module docstring)."""
     names = system.element_names
+    if not names:
+        raise SetupError(f"system {system.name!r} has no elements")
     dup = {n for n in names if names.count(n) > 1}
     if dup:
-        raise ConnectorMismatchError(f"element name(s) used twice: {', '.join(sorted(dup))}")
+        raise DuplicateElementError(f"system {system.name!r}: element name(s) used twice: "
+                                    f"{', '.join(sorted(dup))}")
     for comp in system.elements:
         info = infos[comp.name]
+        cnames = [c.name for c in comp.connectors]
+        cdup = sorted({n for n in cnames if cnames.count(n) > 1})
+        if cdup:
+            raise DuplicateElementError(f"element {comp.name!r} declares the connector(s) "
+                                        f"{', '.join(cdup)} twice")
         for c in comp.connectors:
             var = info.variables.get(c.name)
             if var is None:
@@ -88,16 +133,9 @@ def check_system(system: SystemStructure, infos: dict[str, FmuInfo],
                 raise ConnectorMismatchError(
                     f"connector {comp.name}.{c.name} has unit {c.unit!r} in the SSD but "
                     f"{var.unit!r} in {info.path.name}")
-        for pname in comp.parameters:
-            var = info.variables.get(pname)
-            if var is None:
-                raise UnknownConnectorError(
-                    f"parameter binding {comp.name}.{pname}: {info.path.name} has no variable "
-                    f"{pname!r}")
-            if var.causality not in ("parameter", "input") or var.type != "Real":
-                raise ConnectorMismatchError(
-                    f"parameter binding {comp.name}.{pname}: it is a {var.causality} "
-                    f"{var.type} of {info.path.name}, not a real parameter")
+        for pname, value in comp.parameters.items():
+            check_parameter_value(comp.name, info, pname, value,
+                                  unit=comp.parameter_units.get(pname, ""))
 
     sources: dict[tuple[str, str], tuple[str, str]] = {}
     used_outputs: dict[str, list[str]] = {n: [] for n in names}
@@ -122,8 +160,10 @@ def check_system(system: SystemStructure, infos: dict[str, FmuInfo],
             raise ConnectorMismatchError(
                 f"connection {con}: {con.start} is a {a.causality}, not an output")
         if b.causality != "input":
+            hint = (" (a connection cannot drive a parameter: set it with a parameter "
+                    "binding)" if "arameter" in b.causality else "")
             raise ConnectorMismatchError(
-                f"connection {con}: {con.end} is a {b.causality}, not an input")
+                f"connection {con}: {con.end} is a {b.causality}, not an input{hint}")
         if a.type != b.type:
             raise ConnectorMismatchError(
                 f"connection {con}: type mismatch, {con.start} is {a.type} and {con.end} is "

@@ -10,17 +10,28 @@
     convergence order, both orders with and without extrapolation, wall time per simulated
     second, cross-check with fmucontainer (``--stop-time``, ``--coupling lumped|plain``,
     ``--no-me``, ``--no-cross-check``, ``--fmu-dir DIR`` to keep the FMUs).
+
+Bad input (an unsafe or broken SSP/FMU, an inconsistent set-up, non-finite or absurd times
+and steps, an output folder that does not exist) ends in one line on stderr and exit status
+2, before anything runs; the output files are written only after a successful run, under a
+temporary name renamed at the end (no partial output).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
+import os
+import re
 import sys
+import tempfile
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from ..errors import ParameterError
+from .errors import CosimError, InvalidExperimentError
 
 
 def _sets(items: list[str]) -> dict[str, dict[str, float]]:
@@ -31,10 +42,41 @@ def _sets(items: list[str]) -> dict[str, dict[str, float]]:
         if not sep or not dot or not var:
             raise ParameterError(f"--set expects ELEMENT.NAME=VALUE, got {item!r}")
         try:
-            out.setdefault(el, {})[var] = float(value)
+            x = float(value)
         except ValueError:
             raise ParameterError(f"--set {name}: {value!r} is not a number") from None
+        if not math.isfinite(x):
+            raise ParameterError(f"--set {name}: {value!r} is not finite")
+        out.setdefault(el, {})[var.strip()] = x
     return out
+
+
+def _writable(path: str | None, what: str) -> Path | None:
+    """``path`` as a Path after checking that its folder exists (before the run)."""
+    if not path:
+        return None
+    p = Path(path)
+    if p.is_dir():
+        raise CosimError(f"{what} {p} is a folder, not a file")
+    if not p.parent.is_dir():
+        raise CosimError(f"cannot write the {what} {p}: the folder {p.parent} does not exist")
+    return p
+
+
+def _write_atomically(path: Path, write: Callable[[Path], Any], what: str) -> None:
+    """``write(tmp)`` to a temporary file next to ``path``, then rename it to ``path``."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix,
+                               dir=path.parent)
+    os.close(fd)
+    try:
+        write(Path(tmp))
+        os.replace(tmp, path)
+    except OSError as err:
+        Path(tmp).unlink(missing_ok=True)
+        raise CosimError(f"cannot write the {what} {path}: {err.strerror or err}") from None
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
 
 
 def cmd_cosim(args: argparse.Namespace) -> int:
@@ -42,28 +84,43 @@ def cmd_cosim(args: argparse.Namespace) -> int:
     from .master import Master
     from .ssp import read_ssp
 
+    for value, what in ((args.stop_time, "--stop-time"), (args.step, "--step")):
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise InvalidExperimentError(f"{what} must be a finite number > 0, got {value}")
+    sets = _sets(args.set)
+    out_arg = _writable(args.output, "output file")
+    plot = _writable(args.plot, "plot")
     system = read_ssp(args.ssp)
+    safe = re.sub(r"[^A-Za-z0-9_.-]", "_", system.name).lstrip(".") or "system"
+    out = out_arg or _writable(f"{safe}_cosim.csv", "output file")   # in the working folder
+    assert out is not None
     master = Master(system, interface=args.interface)
     order = args.order or system.master.get("order", "jacobi")
     extrapolation = args.extrapolation
     if extrapolation is None:
         extrapolation = bool(system.master.get("extrapolation", False))
     res = master.simulate(args.stop_time, args.step, order=order, extrapolation=extrapolation,
-                          propagate=not args.no_propagate, parameters=_sets(args.set),
+                          propagate=not args.no_propagate, parameters=sets,
                           record=args.record or ())
-    out = Path(args.output) if args.output else Path(f"{system.name}_cosim.csv")
-    res.to_csv(out)
+    if args.plot_vars:
+        missing = [n for n in args.plot_vars if n not in res.names]
+        if missing:
+            raise CosimError(f"--plot-vars: no result variable {', '.join(missing)} (record "
+                             "locals with --record ELEMENT.VAR)")
+    _write_atomically(out, res.to_csv, "output file")
     meta = res.meta
     print(f"{system.name}: {len(system.elements)} elements ({', '.join(system.element_names)}),"
           f" {meta['order']}{' + extrapolation' if meta['extrapolation'] else ''}, "
           f"step {meta['step']:g} s, {meta['steps']} steps to t = {meta['stop_time']:g} s; "
           f"run {meta['run_seconds']:.3f} s ({meta['seconds_per_simulated_second']:.3f} s "
           f"per simulated s) -> {out}")
-    if args.plot:
+    if plot is not None:
         names = args.plot_vars or [n for n in res.names
                                    if n.split(".", 1)[0] == system.element_names[0]][:6]
-        res.plot(names, args.plot, title=f"{system.name} (co-simulation)")
-        print(f"plot -> {args.plot}")
+        _write_atomically(plot, lambda tmp: res.plot(names, tmp,
+                                                     title=f"{system.name} (co-simulation)"),
+                          "plot")
+        print(f"plot -> {plot}")
     return 0
 
 
@@ -72,8 +129,8 @@ def _steps(text: str) -> list[float]:
         steps = [float(s) for s in text.split(",") if s.strip()]
     except ValueError:
         raise ParameterError(f"--steps expects comma-separated numbers, got {text!r}") from None
-    if not steps or any(s <= 0 for s in steps):
-        raise ParameterError(f"--steps: positive macro steps required, got {text!r}")
+    if not steps or any(not (math.isfinite(s) and s > 0) for s in steps):
+        raise ParameterError(f"--steps: finite positive macro steps required, got {text!r}")
     return steps
 
 
@@ -87,6 +144,9 @@ def cmd_verify(args: argparse.Namespace) -> int:
             sys.stderr.flush()
 
     work = Path(args.fmu_dir) if args.fmu_dir else None
+    if work is not None and work.exists() and not work.is_dir():
+        raise CosimError(f"--fmu-dir {work} exists and is not a folder")
+    plot = _writable(args.plot, "plot")
     report = verify_robot(_steps(args.steps), args.stop_time, coupling=args.coupling,
                           me_step=None if args.no_me else 1e-3,
                           cross_check_step=None if args.no_cross_check else 1e-3,
@@ -95,10 +155,10 @@ def cmd_verify(args: argparse.Namespace) -> int:
         print(json.dumps(report.to_dict(), indent=2))
     else:
         print(report.to_text())
-    if args.plot:
-        path = report.plot(args.plot)
+    if plot is not None:
+        _write_atomically(plot, report.plot, "plot")
         if not args.json:
-            print(f"plot -> {path}")
+            print(f"plot -> {plot}")
     return 0
 
 

@@ -14,23 +14,34 @@ parameters, initialize), ``set_inputs``, ``get``, ``step(t, h, ramp)`` and ``ter
   The last internal step size is carried over to the next macro step.
 
 Only real-valued (Real / Float64) inputs and outputs are supported as connectors.
+
+FMU archives are checked and unpacked by :mod:`.archive` (never ``extractall``): an unsafe,
+truncated or non-FMU zip raises :class:`~.errors.UnsafeArchiveError` /
+:class:`~.errors.FmuFormatError` naming the file. The units capture the FMU's log messages;
+when an FMU call fails, the :class:`~.errors.CosimStepError` carries the FMU's own error
+message (e.g. which parameter is out of range).
 """
 
 from __future__ import annotations
 
 import atexit
+import collections
 import ctypes
+import itertools
 import math
 import shutil
 import tempfile
-import zipfile
+import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .errors import CosimStepError, SetupError
+from .archive import SafeZip, _one_line
+from .errors import CosimStepError, FmuFormatError, SetupError, UnknownConnectorError
+
+MODEL_DESCRIPTION = "modelDescription.xml"
 
 REAL_TYPES = {"Real", "Float64", "Float32"}
 
@@ -55,6 +66,39 @@ class FmuVariable:
     unit: str = ""
     start: float | None = None
     description: str = ""
+    min: float | None = None
+    max: float | None = None
+
+    @property
+    def settable(self) -> bool:
+        """Whether an importer may set it before initialization (a parameter that is not a
+        constant or calculated, or an input's start value)."""
+        if self.causality == "input":
+            return True
+        return self.causality == "parameter" and self.variability in ("fixed", "tunable")
+
+    def range_text(self) -> str:
+        lo = "-inf" if self.min is None else f"{self.min:g}"
+        hi = "inf" if self.max is None else f"{self.max:g}"
+        return f"[{lo}, {hi}]"
+
+    def out_of_range(self, value: float) -> bool:
+        return ((self.min is not None and value < self.min)
+                or (self.max is not None and value > self.max))
+
+
+def _bound(*candidates: Any) -> float | None:
+    """The first of ``candidates`` (strings from the model description) that is a number;
+    infinite bounds are the same as none."""
+    for c in candidates:
+        if c is None or c == "":
+            continue
+        try:
+            value = float(c)
+        except (TypeError, ValueError):
+            continue
+        return value if math.isfinite(value) else None
+    return None
 
 
 @dataclass
@@ -89,36 +133,50 @@ class FmuInfo:
             return self.variables[name]
         except KeyError:
             where = f"element {element!r} ({self.path.name})" if element else self.path.name
-            raise SetupError(f"{where} has no variable {name!r}") from None
+            raise UnknownConnectorError(f"{where} has no variable {name!r}") from None
 
 
 def read_fmu_info(path: str | Path) -> FmuInfo:
-    """Read ``modelDescription.xml`` of the FMU at ``path``."""
+    """Read ``modelDescription.xml`` of the FMU at ``path`` (the archive is checked and
+    unpacked safely first, see :mod:`.archive`; errors: :class:`~.errors.FmuFormatError`,
+    :class:`~.errors.UnsafeArchiveError`)."""
     from fmpy import read_model_description
 
     path = Path(path)
-    if not path.is_file():
-        raise SetupError(f"FMU {path} does not exist")
+    unzipped = _EXTRACTED.get(path)
     try:
-        md = read_model_description(str(path))
-    except Exception as err:  # fmpy raises various errors for broken archives
-        raise SetupError(f"cannot read the model description of {path}: {err}") from err
-    version = int(str(md.fmiVersion).split(".")[0])
+        md = read_model_description(str(unzipped))
+    except Exception as err:  # fmpy raises various errors for broken descriptions
+        raise FmuFormatError(f"{path}: {MODEL_DESCRIPTION} is not a valid FMI model "
+                             f"description: {_one_line(err)}") from None
+    try:
+        version = int(str(md.fmiVersion).split(".")[0])
+    except ValueError:
+        version = 0
+    if version not in (2, 3):
+        raise FmuFormatError(f"{path}: FMI version {md.fmiVersion!r} is not supported "
+                             "(FMI 2.0 and 3.0 are)")
     variables: dict[str, FmuVariable] = {}
     for v in md.modelVariables:
         start = None
-        if v.start is not None and _kind_of_type(v.type) == "Real":
+        kind = _kind_of_type(v.type)
+        if v.start is not None and kind == "Real":
             try:
                 start = float(v.start)
             except (TypeError, ValueError):
                 start = None
+        dt = v.declaredType
+        unit = v.unit or (dt.unit if dt is not None and getattr(dt, "unit", None) else "") or ""
+        lo = hi = None
+        if kind in ("Real", "Integer"):
+            lo = _bound(getattr(v, "min", None), getattr(dt, "min", None))
+            hi = _bound(getattr(v, "max", None), getattr(dt, "max", None))
+        if v.name in variables:
+            raise FmuFormatError(f"{path}: {MODEL_DESCRIPTION} declares the variable "
+                                 f"{v.name!r} twice")
         variables[v.name] = FmuVariable(v.name, int(v.valueReference), str(v.causality),
-                                        str(v.variability), _kind_of_type(v.type),
-                                        v.unit or (v.declaredType.unit if v.declaredType
-                                                   is not None and getattr(
-                                                       v.declaredType, "unit", None)
-                                                   else "") or "",
-                                        start, v.description or "")
+                                        str(v.variability), kind, unit, start,
+                                        v.description or "", lo, hi)
     inputs = [v.name for v in variables.values() if v.causality == "input"]
     feedthrough = {v.name: list(inputs) for v in variables.values() if v.causality == "output"}
     for unknown in md.outputs:
@@ -135,22 +193,27 @@ def read_fmu_info(path: str | Path) -> FmuInfo:
 
 
 class _Extracted:
-    """Unzip each FMU once per process (shared by the instances of one FMU)."""
+    """Unzip each FMU once per process (shared by the instances of one FMU), safely
+    (:class:`~.archive.SafeZip`: checked members, all-or-nothing extraction)."""
 
     def __init__(self) -> None:
         self.dirs: dict[tuple[Path, int, int], Path] = {}
         self.root: Path | None = None
 
     def get(self, path: Path) -> Path:
+        path = Path(path)
+        if not path.is_file():
+            raise FmuFormatError(f"FMU {path} does not exist"
+                                 + ("" if not path.exists() else " (not a file)"))
         path = path.resolve()
         st = path.stat()
         key = (path, st.st_mtime_ns, st.st_size)     # a rebuilt FMU is unzipped again
         if key not in self.dirs:
-            if self.root is None:
-                self.root = Path(tempfile.mkdtemp(prefix="bgm_cosim_"))
-            target = self.root / f"{len(self.dirs):02d}_{path.stem}"
-            with zipfile.ZipFile(path) as zf:
-                zf.extractall(target)
+            with SafeZip(path, "FMU", MODEL_DESCRIPTION, error=FmuFormatError) as zf:
+                if self.root is None:
+                    self.root = Path(tempfile.mkdtemp(prefix="bgm_cosim_"))
+                target = self.root / f"{len(self.dirs):02d}_{path.stem}"
+                zf.extract_all(target)
             self.dirs[key] = target
         return self.dirs[key]
 
@@ -163,6 +226,49 @@ class _Extracted:
 
 _EXTRACTED = _Extracted()
 atexit.register(_EXTRACTED.cleanup)
+
+
+# FMI 2.0 log messages are variadic; fmpy formats them with a native proxy that forwards to
+# ONE process-wide Python logger (a C global set by ``addLoggerProxy``). That logger must
+# therefore live forever: this module's dispatcher, which hands each message to the unit
+# whose componentEnvironment it carries, and prints the others as fmpy would.
+_FMI2_UNITS: dict[int, weakref.ref] = {}
+_FMI2_IDS = itertools.count(1)
+_FMI2_CALLBACKS: Any = None
+
+
+def _fmi2_dispatch(env: Any, name: Any, status: int, category: Any, message: Any) -> None:
+    ref = _FMI2_UNITS.get(int(env or 0))
+    unit = ref() if ref is not None else None
+    if unit is None:
+        from fmpy.fmi1 import printLogMessage
+
+        printLogMessage(env, name, status, category, message)
+        return
+    unit._log(status, category, message)
+
+
+def _fmi2_callbacks(unit_id: int) -> Any:
+    """A callback structure whose logger reaches :func:`_fmi2_dispatch` with ``unit_id``."""
+    global _FMI2_CALLBACKS
+    from fmpy import calloc, free
+    from fmpy.fmi2 import (
+        fmi2CallbackAllocateMemoryTYPE,
+        fmi2CallbackFreeMemoryTYPE,
+        fmi2CallbackFunctions,
+        fmi2CallbackLoggerTYPE,
+    )
+    from fmpy.logging import addLoggerProxy
+
+    if _FMI2_CALLBACKS is None:      # created once, never freed
+        _FMI2_CALLBACKS = (fmi2CallbackLoggerTYPE(_fmi2_dispatch),
+                           fmi2CallbackAllocateMemoryTYPE(calloc),
+                           fmi2CallbackFreeMemoryTYPE(free))
+    cb = fmi2CallbackFunctions()
+    cb.logger, cb.allocateMemory, cb.freeMemory = _FMI2_CALLBACKS
+    cb.componentEnvironment = unit_id
+    addLoggerProxy(ctypes.byref(cb))   # cb.logger := proxy; the proxy's target := dispatcher
+    return cb
 
 
 class _Unit:
@@ -184,6 +290,10 @@ class _Unit:
         self._u_buf = np.zeros(len(self._vr_u))
         self._y_buf = np.zeros(len(self._vr_y))
         self.time = 0.0
+        # (status, category, message) logged by the FMU; the last errors go into exceptions
+        self.messages: collections.deque[tuple[int, str, str]] = collections.deque(maxlen=50)
+        self._callbacks: Any = None
+        self._n_logged = 0
 
     # fast real access with preallocated buffers ---------------------------------------------
     def _set(self, vr_arr: Any, values: np.ndarray) -> None:
@@ -227,15 +337,30 @@ class _Unit:
         arr = (ctypes.c_uint32 * len(vrs))(*vrs)
         self._call(self._set, arr, np.array([float(v) for v in values.values()]))
 
-    def _call(self, fn: Any, *args: Any) -> Any:
+    def _log(self, status: int, category: Any, message: Any) -> None:
+        def text(b: Any) -> str:
+            return b.decode("utf-8", "replace") if isinstance(b, bytes) else str(b or "")
+        self.messages.append((int(status), text(category), text(message)))
+        self._n_logged += 1
+
+    def fmu_errors(self) -> list[str]:
+        """The messages the FMU logged with status Discard, Error or Fatal."""
+        return [m for status, _, m in self.messages if status >= 2]
+
+    def _call(self, fn: Any, *args: Any, **kw: Any) -> Any:
+        n_before = self._n_logged
         try:
-            return fn(*args)
+            return fn(*args, **kw)
         except CosimStepError:
             raise
         except Exception as err:
+            new = min(self._n_logged - n_before, len(self.messages))
+            said = [m for status, _, m in list(self.messages)[len(self.messages) - new:]
+                    if status >= 2]
+            detail = f"{err}" + (f" -- the FMU says: {' | '.join(said[-2:])}" if said else "")
             raise CosimStepError(f"element {self.name!r} ({self.info.path.name}): FMU call "
-                                 f"failed at t={self.time:g}: {err}", self.name,
-                                 self.time) from err
+                                 f"failed at t={self.time:g}: {_one_line(detail, 600)}",
+                                 self.name, self.time) from err
 
     def _instantiate(self, slave: bool) -> None:
         from fmpy import fmi2, fmi3
@@ -248,14 +373,32 @@ class _Unit:
         kw = dict(unzipDirectory=unzip, modelIdentifier=ident, instanceName=self.name)
         if self.info.fmi_version == 2:
             cls = fmi2.FMU2Slave if slave else fmi2.FMU2Model
-            self.fmu = cls(guid=self.info.guid, **kw)
         elif self.info.fmi_version == 3:
             cls = fmi3.FMU3Slave if slave else fmi3.FMU3Model
-            self.fmu = cls(guid=self.info.guid, **kw)   # fmpy: the token is passed as guid
         else:
             raise SetupError(f"element {self.name!r}: FMI {self.info.fmi_version} is not "
                              "supported (FMI 2.0 and 3.0 are)")
-        self._call(self.fmu.instantiate)
+        try:
+            self.fmu = cls(guid=self.info.guid, **kw)  # fmpy: the FMI 3 token goes as guid
+        except Exception as err:  # no binary for this platform, unloadable library...
+            raise SetupError(f"element {self.name!r}: cannot load the binary of "
+                             f"{self.info.path.name}: {_one_line(err)}") from None
+        if self.info.fmi_version == 2:
+            unit_id = next(_FMI2_IDS)
+            _FMI2_UNITS[unit_id] = weakref.ref(self)
+            self._fmi2_id = unit_id
+            self._callbacks = _fmi2_callbacks(unit_id)   # the FMU keeps a pointer to it
+            self._call(self.fmu.instantiate, callbacks=self._callbacks)
+        else:
+            ref = weakref.ref(self)
+
+            def log3(env: Any, status: int, category: Any, message: Any) -> None:
+                unit = ref()
+                if unit is not None:
+                    unit._log(status, category, message)
+
+            self._callbacks = log3                # fmpy keeps it as fmu.logMessage too
+            self._call(self.fmu.instantiate, logMessage=log3)
 
     def terminate(self) -> None:
         if self.fmu is None:
@@ -269,6 +412,7 @@ class _Unit:
         except Exception:  # noqa: BLE001
             pass
         self.fmu = None
+        _FMI2_UNITS.pop(getattr(self, "_fmi2_id", -1), None)
 
 
 class CoSimUnit(_Unit):
@@ -384,8 +528,10 @@ class ModelExchangeUnit(_Unit):
             except CosimStepError:
                 raise
             except Exception as err:
+                said = self.fmu_errors()[-1:]
+                detail = f"{err}" + (f" -- the FMU says: {said[0]}" if said else "")
                 raise CosimStepError(f"element {self.name!r}: integration failed at t={t:g}: "
-                                     f"{err}", self.name, t) from err
+                                     f"{_one_line(detail, 600)}", self.name, t) from err
             if not sol.success:
                 raise CosimStepError(f"element {self.name!r}: integration failed at t={t:g}: "
                                      f"{sol.message}", self.name, t)

@@ -32,6 +32,14 @@ Results: :class:`bgmodelica.Result` with ``<element>.<variable>`` names: every c
 (inputs: the coupled value at the communication point) and any variable asked for in
 ``record``; bound parameters are in ``result.parameters``; ``result.meta`` has the options
 and wall-clock times.
+
+Everything is checked before an FMU is instantiated: start/stop time and macro step must be
+finite, the horizon a multiple of the step and the number of macro steps at most
+``max_steps`` (default :data:`MAX_STEPS`; the message gives the number that would be
+needed), the recorded table at most :data:`MAX_RECORD_BYTES`; parameter overrides must name
+settable real parameters (or inputs) with finite values inside the FMU's ``[min, max]``
+(:class:`~.errors.InvalidExperimentError`, :class:`~.errors.InvalidParameterError`,
+:class:`~.errors.UnknownConnectorError`).
 """
 
 from __future__ import annotations
@@ -45,16 +53,62 @@ from typing import Any
 import numpy as np
 
 from ..result import Result
-from .checks import Plan, check_system
-from .errors import CosimStepError, SetupError
+from .archive import _size
+from .checks import Plan, check_parameter_value, check_system
+from .errors import (
+    CosimStepError,
+    InvalidExperimentError,
+    SetupError,
+    UnknownConnectorError,
+)
 from .fmu import FmuInfo, make_unit, read_fmu_info
 from .ssp import SystemStructure, read_ssp
 
 ORDERS = ("jacobi", "gauss-seidel")
+MAX_STEPS = 100_000_000              # macro steps of one run (1e8: hours of FMU calls)
+MAX_RECORD_BYTES = 4 << 30           # the recorded table (points x columns x 8 bytes)
+
+
+def _finite(value: Any, what: str) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise InvalidExperimentError(f"{what} {value!r} is not a number") from None
+    if not math.isfinite(x):
+        raise InvalidExperimentError(f"{what} {x} is not finite")
+    return x
+
+
+def count_steps(start_time: Any, stop_time: Any, step: Any,
+                max_steps: int | None = None) -> int:
+    """The number of macro steps ``step`` from ``start_time`` to ``stop_time``; raises
+    :class:`~.errors.InvalidExperimentError` unless all are finite, ``step > 0``, the
+    horizon positive and a multiple of the step, and the count at most ``max_steps``
+    (default :data:`MAX_STEPS`)."""
+    t0 = _finite(start_time, "start time")
+    t1 = _finite(stop_time, "stop time")
+    h = _finite(step, "macro step")
+    limit = MAX_STEPS if max_steps is None else int(max_steps)
+    if not h > 0:
+        raise InvalidExperimentError(f"macro step must be > 0, got {h:g}")
+    span = t1 - t0
+    if not span > 0 or not math.isfinite(span):
+        raise InvalidExperimentError(f"stop time {t1:g} must be after the start time {t0:g}")
+    ratio = span / h
+    if not math.isfinite(ratio) or ratio > limit + 0.5:
+        raise InvalidExperimentError(
+            f"the horizon {span:g} s at macro step {h:g} s needs {ratio:.4g} macro steps, "
+            f"more than the limit of {limit:.4g} (a wrong unit or a typo in the stop time or "
+            "step? Master.simulate(max_steps=...) allows more)")
+    n_steps = int(round(ratio))
+    if n_steps < 1 or abs(n_steps * h - span) > 1e-9 * max(1.0, span):
+        raise InvalidExperimentError(f"the horizon {span:g} s is not a multiple of the macro "
+                                     f"step {h:g} s")
+    return n_steps
 
 
 def _norm_order(order: str) -> str:
-    o = order.lower().replace("_", "-")
+    o = str(order).lower().replace("_", "-")
     if o in ("gs", "gauss-seidel", "gaussseidel", "seidel", "sequential"):
         return "gauss-seidel"
     if o in ("jacobi", "parallel"):
@@ -85,6 +139,15 @@ class Master:
                                  f"{comp.source!r})")
             self.infos[comp.name] = read_fmu_info(comp.fmu_path)
         self.plan: Plan = check_system(system, self.infos, allow_unconnected)
+        if isinstance(interface, Mapping):
+            unknown = sorted(set(interface) - set(self.infos))
+            if unknown:
+                raise UnknownConnectorError(f"interface given for unknown element(s) "
+                                            f"{', '.join(unknown)} (elements: "
+                                            f"{', '.join(system.element_names)})")
+        for name, tol in (("me_rtol", me_rtol), ("me_atol", me_atol)):
+            if not (isinstance(tol, (int, float)) and math.isfinite(tol) and tol > 0):
+                raise InvalidExperimentError(f"{name} must be finite and > 0, got {tol!r}")
         self.interfaces = {c.name: self._interface(c.name, c.implementation, interface)
                            for c in system.elements}
         self.me_rtol, self.me_atol = me_rtol, me_atol
@@ -113,7 +176,8 @@ class Master:
                  start_time: float | None = None, sequence: Sequence[str] | None = None,
                  parameters: Mapping[str, Mapping[str, float]] | None = None,
                  record: Iterable[str] = (), tolerance: float | None = None,
-                 record_every: int = 1, max_abs: float | None = None) -> Result:
+                 record_every: int = 1, max_abs: float | None = None,
+                 max_steps: int | None = None) -> Result:
         """Run the co-simulation and return the :class:`~bgmodelica.Result`.
 
         ``stop_time``/``step``: default from the SSD (DefaultExperiment, the master
@@ -123,23 +187,31 @@ class Master:
         ``record_every``: keep every n-th communication point (the last one always).
         ``max_abs``: stop with :class:`~.errors.CosimStepError` as soon as a coupled output
         exceeds this magnitude (an unstable coupling; None: only non-finite values stop).
+        ``max_steps``: refuse runs with more macro steps (default :data:`MAX_STEPS`).
         """
         system = self.system
         order = _norm_order(order)
-        t0 = float(system.start_time if start_time is None else start_time)
+        t0 = _finite(system.start_time if start_time is None else start_time, "start time")
         t_end = stop_time if stop_time is not None else system.stop_time
         if t_end is None:
-            raise SetupError("no stop time: give stop_time or set the SSD DefaultExperiment")
-        h = float(step if step is not None else system.master.get("step_size", 1e-3))
-        if not (h > 0 and math.isfinite(h)):
-            raise SetupError(f"macro step must be > 0, got {h}")
-        span = float(t_end) - t0
-        if span <= 0:
-            raise SetupError(f"stop time {t_end} must be after the start time {t0}")
-        n_steps = int(round(span / h))
-        if n_steps < 1 or abs(n_steps * h - span) > 1e-9 * max(1.0, span):
-            raise SetupError(f"the horizon {span:g} s is not a multiple of the macro step "
-                             f"{h:g} s")
+            raise InvalidExperimentError("no stop time: give stop_time or set the SSD "
+                                         "DefaultExperiment")
+        t_end = _finite(t_end, "stop time")
+        h = _finite(step if step is not None else system.master.get("step_size", 1e-3),
+                    "macro step")
+        n_steps = count_steps(t0, t_end, h, max_steps)
+        span = t_end - t0
+        if tolerance is not None and not (_finite(tolerance, "tolerance") > 0):
+            raise InvalidExperimentError(f"tolerance must be > 0, got {tolerance!r}")
+        if max_abs is not None and not float(max_abs) > 0:      # NaN would never trigger
+            raise InvalidExperimentError(f"max_abs must be > 0, got {max_abs!r}")
+        try:
+            every = int(record_every)
+        except (TypeError, ValueError):
+            every = 0
+        if every < 1 or every != record_every:
+            raise InvalidExperimentError(f"record_every must be a positive integer, got "
+                                         f"{record_every!r}")
         names = system.element_names
         seq = list(sequence) if sequence is not None else list(names)
         if sorted(seq) != sorted(names):
@@ -148,18 +220,29 @@ class Master:
         params = {c.name: dict(c.parameters) for c in system.elements}
         for el, vals in (parameters or {}).items():
             if el not in params:
-                raise SetupError(f"parameters for unknown element {el!r}")
-            for p in vals:
+                raise UnknownConnectorError(f"parameters for unknown element {el!r} "
+                                            f"(elements: {', '.join(names)})")
+            for p, v in vals.items():
                 if p not in self.infos[el].variables:
-                    raise SetupError(f"element {el!r} has no variable {p!r}")
-            params[el].update({k: float(v) for k, v in vals.items()})
+                    raise UnknownConnectorError(f"element {el!r} has no variable {p!r}")
+                params[el][p] = check_parameter_value(el, self.infos[el], p, v,
+                                                      "parameter override")
         extra: dict[str, list[str]] = {n: [] for n in names}
         for full in record:
             el, _, var = full.partition(".")
             if el not in extra or not var:
-                raise SetupError(f"record: {full!r} is not <element>.<variable>")
+                raise UnknownConnectorError(f"record: {full!r} is not <element>.<variable> "
+                                            f"(elements: {', '.join(names)})")
             self.infos[el].variable(var, el)
             extra[el].append(var)
+        n_cols = sum(len(plan.inputs[n]) + len(plan.outputs[n]) + len(extra[n])
+                     for n in names)
+        n_rows = n_steps // every + 1 + (1 if n_steps % every else 0)
+        if n_rows * (n_cols + 1) * 8 > MAX_RECORD_BYTES:
+            raise InvalidExperimentError(
+                f"recording {n_rows} communication points of {n_cols} variables needs "
+                f"{_size(n_rows * (n_cols + 1) * 8)}, more than {_size(MAX_RECORD_BYTES)}: "
+                "record fewer points (record_every)")
 
         # index tables -------------------------------------------------------------------
         out_pos = {n: {y: k for k, y in enumerate(plan.outputs[n])} for n in names}
@@ -187,7 +270,7 @@ class Master:
                 units[n] = unit
                 pset = {k: v for k, v in params[n].items()
                         if self.infos[n].variables[k].causality == "parameter"}
-                unit.setup(t0, float(t_end), pset, start_u[n], tolerance)
+                unit.setup(t0, t_end, pset, start_u[n], tolerance)
             y = {n: units[n].get_outputs() for n in names}
             last_set = {n: start_u[n].copy() for n in names}
 
@@ -218,17 +301,13 @@ class Master:
                 cols += [f"{n}.{u}" for u in plan.inputs[n]]
                 cols += [f"{n}.{v}" for v in plan.outputs[n]]
                 cols += [f"{n}.{v}" for v in extra[n]]
-            keep = list(range(0, n_steps + 1, max(1, int(record_every))))
-            if keep[-1] != n_steps:
-                keep.append(n_steps)
-            keep_set = set(keep)
-            data = np.empty((len(keep), len(cols)))
-            times = np.empty(len(keep))
+            data = np.empty((n_rows, len(cols)))
+            times = np.empty(n_rows)
             row = 0
 
             def record_point(k: int, t: float) -> None:
                 nonlocal row
-                if k not in keep_set:
+                if k % every and k != n_steps:
                     return
                 parts = []
                 for n in names:
@@ -324,7 +403,7 @@ class Master:
         meta = {
             "master": "bgmodelica.cosim", "order": order, "extrapolation": bool(extrapolation),
             "propagate": bool(propagate), "step": h, "steps": n_steps, "start_time": t0,
-            "stop_time": float(t_end), "interfaces": dict(self.interfaces),
+            "stop_time": t_end, "interfaces": dict(self.interfaces),
             "sequence": seq if order == "gauss-seidel" else None,
             "setup_seconds": wall_setup, "run_seconds": wall_run,
             "seconds_per_simulated_second": wall_run / span,

@@ -21,6 +21,14 @@ prefixes, parameter sets in separate ``.ssv`` files (``<ssd:ParameterBinding
 source="resources/x.ssv">``, with an optional ``prefix`` stripped from the parameter names)
 and FMUs referenced relative to the archive. Only flat systems (no nested ``<ssd:System>``)
 of FMU components are supported.
+
+Reading is defensive: the archive is checked as a whole by :class:`~.archive.SafeZip`
+(unsafe member names, symbolic links, duplicates, zip bombs, truncation) before anything is
+extracted; component sources must be plain relative paths inside the archive; two
+components, two connectors of one component or two values in one parameter set with the
+same name are refused (:class:`~.errors.DuplicateElementError`), and so are non-numeric,
+non-finite or (for Integer/Boolean) non-integral parameter values. Extraction writes only
+into the extraction folder and removes what it wrote if it fails.
 """
 
 from __future__ import annotations
@@ -33,11 +41,17 @@ import xml.etree.ElementTree as ET
 import zipfile
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
-from pathlib import Path, PurePosixPath
+from pathlib import Path
 from typing import Any
 
 from ..fmi.units import BASE, parse_unit
-from .errors import SspFormatError, UnknownConnectorError
+from .archive import SafeZip, normalize, unsafe_reason
+from .errors import (
+    DuplicateElementError,
+    SspFormatError,
+    UnknownConnectorError,
+    UnsafeArchiveError,
+)
 
 NS = {
     "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
@@ -81,6 +95,7 @@ class SspComponent:
     implementation: str = "any"                  # any, CoSimulation, ModelExchange
     fmu_path: Path | None = None                 # the FMU file (resolved)
     description: str = ""
+    parameter_units: dict[str, str] = field(default_factory=dict)   # unit given in the SSV
 
     def connector(self, name: str) -> SspConnector | None:
         for c in self.connectors:
@@ -234,8 +249,10 @@ def ssd_xml(system: SystemStructure) -> bytes:
                 p = ET.SubElement(params, _q("ssv", "Parameter"), name=pname)
                 conn = comp.connector(pname)
                 ra = {"value": _num(value)}
-                if conn is not None and conn.unit:
-                    ra["unit"] = conn.unit
+                unit = comp.parameter_units.get(pname) or (conn.unit if conn is not None
+                                                          else "")
+                if unit:
+                    ra["unit"] = unit
                 ET.SubElement(p, _q("ssv", "Real"), ra)
     if system.connections:
         cons = ET.SubElement(sysel, _q("ssd", "Connections"))
@@ -278,6 +295,10 @@ def write_ssp(system: SystemStructure, path: str | Path) -> Path:
     component's ``source`` is rewritten to ``resources/<file>.fmu`` (one copy per distinct
     FMU file, shared by the components that use it). Returns the path."""
     path = Path(path)
+    dup = sorted({n for n in system.element_names if system.element_names.count(n) > 1})
+    if dup:
+        raise DuplicateElementError(f"system {system.name!r}: element name(s) used twice: "
+                                    f"{', '.join(dup)}")
     path.parent.mkdir(parents=True, exist_ok=True)
     names: dict[Path, str] = {}
     taken: set[str] = set()
@@ -296,13 +317,17 @@ def write_ssp(system: SystemStructure, path: str | Path) -> Path:
             taken.add(candidate)
         comp.source = f"resources/{names[src]}"
     tmp = path.with_name(path.name + ".part")
-    with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zf:
-        zf.writestr(zipfile.ZipInfo(SSD_NAME, (2000, 1, 1, 0, 0, 0)), ssd_xml(system))
-        for src, name in names.items():
-            info = zipfile.ZipInfo(f"resources/{name}", (2000, 1, 1, 0, 0, 0))
-            info.compress_type = zipfile.ZIP_STORED     # an FMU is already a zip
-            zf.writestr(info, src.read_bytes())
-    tmp.replace(path)
+    try:
+        with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zf:
+            zf.writestr(zipfile.ZipInfo(SSD_NAME, (2000, 1, 1, 0, 0, 0)), ssd_xml(system))
+            for src, name in names.items():
+                info = zipfile.ZipInfo(f"resources/{name}", (2000, 1, 1, 0, 0, 0))
+                info.compress_type = zipfile.ZIP_STORED     # an FMU is already a zip
+                zf.writestr(info, src.read_bytes())
+        tmp.replace(path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)                     # no partial archive
+        raise
     return path
 
 
@@ -334,7 +359,8 @@ def _float(text: str | None, what: str) -> float:
     return value
 
 
-def _parameter_set(ps: ET.Element, where: str, prefix: str = "") -> dict[str, float]:
+def _parameter_set(ps: ET.Element, where: str, prefix: str = "",
+                   units: dict[str, str] | None = None) -> dict[str, float]:
     if _local(ps.tag) != (NS["ssv"], "ParameterSet"):
         raise SspFormatError(f"{where}: expected <ssv:ParameterSet>, found <{ps.tag}>")
     out: dict[str, float] = {}
@@ -345,13 +371,25 @@ def _parameter_set(ps: ET.Element, where: str, prefix: str = "") -> dict[str, fl
             raise SspFormatError(f"{where}: <ssv:Parameter> without a name")
         if prefix and name.startswith(prefix):
             name = name[len(prefix):]
+        if name in out:
+            raise DuplicateElementError(f"{where}: parameter {name!r} is given twice in one "
+                                        "parameter set")
         value = None
         for typ in ("Real", "Integer", "Boolean"):
             v = _child(p, "ssv", typ)
             if v is not None:
                 text = v.get("value")
-                value = (1.0 if text == "true" else 0.0) if typ == "Boolean" \
-                    else _float(text, f"{where}: parameter {name}")
+                what = f"{where}: parameter {name}"
+                if typ == "Boolean":
+                    if text not in ("true", "false", "1", "0"):
+                        raise SspFormatError(f"{what}: {text!r} is not a Boolean (true/false)")
+                    value = 1.0 if text in ("true", "1") else 0.0
+                else:
+                    value = _float(text, what)
+                    if typ == "Integer" and value != int(value):
+                        raise SspFormatError(f"{what}: {text!r} is not an Integer")
+                if typ == "Real" and v.get("unit") and units is not None:
+                    units[name] = v.get("unit")
                 break
         if value is None:
             raise SspFormatError(f"{where}: parameter {name!r} has no Real/Integer/Boolean "
@@ -360,7 +398,10 @@ def _parameter_set(ps: ET.Element, where: str, prefix: str = "") -> dict[str, fl
     return out
 
 
-def _read_bindings(comp_el: ET.Element, where: str, zf: zipfile.ZipFile) -> dict[str, float]:
+def _read_bindings(comp_el: ET.Element, where: str, zf: Any,
+                   units: dict[str, str] | None = None) -> dict[str, float]:
+    """The parameter values of a component (later bindings override earlier ones, as in
+    SSP); ``zf``: a :class:`~.archive.SafeZip` or a :class:`zipfile.ZipFile`."""
     out: dict[str, float] = {}
     pbs = _child(comp_el, "ssd", "ParameterBindings")
     for pb in _children(pbs, "ssd", "ParameterBinding") if pbs is not None else []:
@@ -369,25 +410,33 @@ def _read_bindings(comp_el: ET.Element, where: str, zf: zipfile.ZipFile) -> dict
             raise SspFormatError(f"{where}: parameter mappings (.ssm) are not supported")
         source = pb.get("source")
         if source:
-            name = str(PurePosixPath(source))
+            reason = unsafe_reason(source)
+            if reason is not None:
+                raise UnsafeArchiveError(f"{where}: parameter file {source!r} has {reason} "
+                                         "(only files inside the archive can be referenced)")
+            name = normalize(source)
             try:
-                doc = ET.fromstring(zf.read(name))
+                data = zf.read(name, f"{where}: parameter file") if isinstance(zf, SafeZip) \
+                    else zf.read(name)
             except KeyError:
                 raise SspFormatError(f"{where}: parameter file {source!r} is not in the "
                                      "archive") from None
+            try:
+                doc = ET.fromstring(data)
             except ET.ParseError as err:
                 raise SspFormatError(f"{where}: {source} is not well-formed XML: {err}") \
                     from None
-            out.update(_parameter_set(doc, f"{where} ({source})", prefix))
+            out.update(_parameter_set(doc, f"{where} ({source})", prefix, units))
         values = _child(pb, "ssd", "ParameterValues")
         if values is not None:
             for ps in values:
-                out.update(_parameter_set(ps, where, prefix))
+                out.update(_parameter_set(ps, where, prefix, units))
     return out
 
 
-def parse_ssd(text: bytes, zf: zipfile.ZipFile | None = None) -> SystemStructure:
-    """Parse an SSD document (``zf``: the archive, for ``.ssv`` files it refers to)."""
+def parse_ssd(text: bytes, zf: Any = None) -> SystemStructure:
+    """Parse an SSD document (``zf``: the archive, a :class:`~.archive.SafeZip` or a
+    :class:`zipfile.ZipFile`, for the ``.ssv`` files it refers to)."""
     try:
         root = ET.fromstring(text)
     except ET.ParseError as err:
@@ -414,6 +463,9 @@ def parse_ssd(text: bytes, zf: zipfile.ZipFile | None = None) -> SystemStructure
         name, source = el.get("name"), el.get("source")
         if not name or not source:
             raise SspFormatError(f"{SSD_NAME}: a <ssd:Component> lacks its name or source")
+        if any(e.name == name for e in elements):
+            raise DuplicateElementError(f"{SSD_NAME}: two components are named {name!r}; "
+                                        "element names must be unique")
         typ = el.get("type", FMU_TYPE)
         if typ != FMU_TYPE:
             raise SspFormatError(f"component {name!r}: type {typ!r} is not an FMU "
@@ -427,12 +479,22 @@ def parse_ssd(text: bytes, zf: zipfile.ZipFile | None = None) -> SystemStructure
                 if uri == NS["ssc"] and tname in ("Real", "Integer", "Boolean", "String",
                                                    "Enumeration", "Binary"):
                     ctype, unit = tname, t.get("unit", "")
-            conns.append(SspConnector(c.get("name", ""), c.get("kind", "unspecified"), ctype,
+            cname = c.get("name", "")
+            if not cname:
+                raise SspFormatError(f"{SSD_NAME}: a connector of component {name!r} has no "
+                                     "name")
+            if any(k.name == cname for k in conns):
+                raise DuplicateElementError(f"{SSD_NAME}: component {name!r} declares the "
+                                            f"connector {cname!r} twice")
+            conns.append(SspConnector(cname, c.get("kind", "unspecified"), ctype,
                                       unit, c.get("description", "")))
-        params = _read_bindings(el, f"component {name!r}", zf) if zf is not None else {}
+        punits: dict[str, str] = {}
+        params = _read_bindings(el, f"component {name!r}", zf, punits) \
+            if zf is not None else {}
         elements.append(SspComponent(name, source, conns, params, typ,
                                      el.get("implementation", "any"),
-                                     description=el.get("description", "")))
+                                     description=el.get("description", ""),
+                                     parameter_units=punits))
     connections = []
     cons = _child(sysel, "ssd", "Connections")
     for c in _children(cons, "ssd", "Connection") if cons is not None else []:
@@ -453,6 +515,12 @@ def parse_ssd(text: bytes, zf: zipfile.ZipFile | None = None) -> SystemStructure
                 for m in ann:
                     for k, v in m.attrib.items():
                         master[_snake(k)] = _auto(v)
+    if "step_size" in master:
+        master["step_size"] = _float(str(master["step_size"]),
+                                     "DefaultExperiment annotation stepSize")
+    if stop is not None and not stop > start:
+        raise SspFormatError(f"{SSD_NAME}: DefaultExperiment stopTime {stop!r} is not after "
+                             f"startTime {start!r}")
     return SystemStructure(sys_name, elements, connections, start, stop,
                            root.get("description", ""), master)
 
@@ -469,37 +537,45 @@ def _auto(text: str) -> Any:
 def read_ssp(path: str | Path, extract_to: str | Path | None = None) -> SystemStructure:
     """Read an ``.ssp`` archive; its FMUs are extracted to ``extract_to`` (default: a new
     temporary directory, removed at exit; ``system.root``) and each component's ``fmu_path``
-    points there."""
+    points there. The archive is checked first (:class:`~.archive.SafeZip`); component
+    sources must be relative paths of members of the archive. Errors:
+    :class:`~.errors.SspFormatError`, :class:`~.errors.UnsafeArchiveError`,
+    :class:`~.errors.DuplicateElementError`."""
     path = Path(path)
-    if not path.is_file():
-        raise SspFormatError(f"SSP file {path} does not exist")
-    try:
-        zf = zipfile.ZipFile(path)
-    except zipfile.BadZipFile:
-        raise SspFormatError(f"{path} is not an SSP archive (not a zip file)") from None
-    with zf:
-        try:
-            text = zf.read(SSD_NAME)
-        except KeyError:
-            raise SspFormatError(f"{path}: no {SSD_NAME} in the archive") from None
-        system = parse_ssd(text, zf)
-        if extract_to:
+    with SafeZip(path, "SSP", SSD_NAME, error=SspFormatError) as zf:
+        system = parse_ssd(zf.read(SSD_NAME), zf)
+        sources: dict[str, str] = {}
+        for comp in system.elements:
+            reason = unsafe_reason(comp.source)
+            if reason is not None:
+                raise UnsafeArchiveError(
+                    f"{path}: component {comp.name!r} refers to {comp.source!r}, which has "
+                    f"{reason}; only FMUs inside the archive can be used")
+            src = normalize(comp.source)
+            if src not in zf.members:
+                raise SspFormatError(f"{path}: component {comp.name!r} refers to {comp.source!r}"
+                                     ", which is not in the archive")
+            sources[comp.name] = src
+        created = extract_to is None
+        if extract_to is not None:
             root = Path(extract_to)
         else:
             root = Path(tempfile.mkdtemp(prefix="bgm_ssp_"))
             atexit.register(shutil.rmtree, root, True)
-        root.mkdir(parents=True, exist_ok=True)
-        members = set(zf.namelist())
-        for comp in system.elements:
-            src = str(PurePosixPath(comp.source.removeprefix("./")))
-            if src not in members:
-                raise SspFormatError(f"{path}: component {comp.name!r} refers to {comp.source!r}"
-                                     ", which is not in the archive")
-            target = root / src
-            if not target.is_file():
-                target.parent.mkdir(parents=True, exist_ok=True)
-                with zf.open(src) as fin, target.open("wb") as fout:
-                    shutil.copyfileobj(fin, fout)
-            comp.fmu_path = target
+        written: dict[str, Path] = {}
+        try:
+            for comp in system.elements:
+                src = sources[comp.name]
+                if src not in written:      # one copy per member, fresh (never a stale file)
+                    written[src] = zf.extract_member(src, root, src,
+                                                     f"component {comp.name!r}: source")
+                comp.fmu_path = written[src]
+        except BaseException:
+            if created:
+                shutil.rmtree(root, ignore_errors=True)
+            else:
+                for f in written.values():
+                    f.unlink(missing_ok=True)
+            raise
     system.root = root
     return system

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import CosimStepError
+from .errors import CosimStepError, InvalidExperimentError
 
 DEFAULT_STEPS = (10e-3, 5e-3, 2e-3, 1e-3, 5e-4)
 #: A coupled output beyond this magnitude (rad, rad/s, V, A, N.m) means the run diverged.
@@ -203,7 +203,38 @@ def _grid(steps: Sequence[float]) -> float:
         g = base / div
         if all(abs(s / g - round(s / g)) < 1e-6 for s in steps):
             return g
-    raise ValueError(f"steps {steps} have no common grid")
+    raise InvalidExperimentError(f"the macro steps {', '.join(f'{s:g}' for s in steps)} have "
+                                 "no common output grid (make each a multiple of the smallest "
+                                 "divided by at most 1000)")
+
+
+#: Points of the monolithic reference at most (the grid of all the macro steps).
+MAX_REFERENCE_POINTS = 10_000_000
+
+
+def check_options(steps: Sequence[float], stop_time: float, me_step: float | None,
+                  me_stop_time: float | None, cross_check_step: float | None,
+                  cross_check_stop_time: float | None) -> float:
+    """Refuse non-finite, non-positive, absurd or inconsistent steps and horizons before
+    anything is built (:class:`~.errors.InvalidExperimentError`); return the output grid."""
+    from .master import count_steps
+
+    if not steps:
+        raise InvalidExperimentError("no macro steps given")
+    for h in steps:
+        count_steps(0.0, stop_time, h)
+    if me_step:
+        count_steps(0.0, me_stop_time or stop_time, me_step)
+    if cross_check_step:
+        count_steps(0.0, cross_check_stop_time or stop_time, cross_check_step)
+    grid = _grid([float(h) for h in steps] + ([float(me_step)] if me_step else []))
+    points = float(stop_time) / grid
+    if points > MAX_REFERENCE_POINTS:
+        raise InvalidExperimentError(
+            f"the reference on the common grid {grid:g} s of the macro steps over "
+            f"{float(stop_time):g} s needs {points:.4g} points, more than "
+            f"{MAX_REFERENCE_POINTS:.0e}: choose steps that are simple multiples of each other")
+    return grid
 
 
 def verify_robot(steps: Sequence[float] = DEFAULT_STEPS, stop_time: float = 10.0, *,
@@ -235,8 +266,14 @@ def verify_robot(steps: Sequence[float] = DEFAULT_STEPS, stop_time: float = 10.0
     from .xcheck import cross_check
 
     say = progress or (lambda _msg: None)
-    steps = sorted((float(s) for s in steps), reverse=True)
-    grid = _grid(steps + ([me_step] if me_step else []))
+    try:
+        steps = sorted((float(s) for s in steps), reverse=True)
+    except (TypeError, ValueError):
+        raise InvalidExperimentError(f"macro steps must be numbers, got {steps!r}") from None
+    grid = check_options(steps, stop_time, me_step, me_stop_time, cross_check_step,
+                         cross_check_stop_time)
+    if coupling not in ("lumped", "plain"):
+        raise InvalidExperimentError(f"coupling must be 'lumped' or 'plain', not {coupling!r}")
     timings: dict[str, float] = {}
     tmp = None
     if fmus is None:

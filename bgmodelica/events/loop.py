@@ -500,7 +500,8 @@ class HybridSimulator:
             init = initialize(dae, self.p, t)
             return init.x0, init.z0
         if fixed:
-            d = replace(dae, x_start=np.asarray(x, dtype=float), fixed=fixed)
+            d = replace(dae, x_start=np.asarray(x, dtype=float), fixed=fixed,
+                        initial=dae.initial[:0], initial_labels=[])  # not initial
             init = initialize(d, self.p, t)
             return init.x0, init.z0
         return x, self._solve_z(t, x)

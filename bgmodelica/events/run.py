@@ -40,6 +40,7 @@ def simulate_hybrid(compiled, dae: CasadiDAE, p: np.ndarray, grid: np.ndarray, *
     flat = compiled.reduced.model
     units = {v.name: v.decl.unit for v in flat.variables}
     units.update({d.name: d.decl.unit for d in flat.discretes})
+    units.update({q.name: q.decl.unit for q in (*flat.parameters, *flat.inputs)})
     params_out = dae.parameter_values(p)
     meta = {"compile_seconds": compiled.compile_time,
             "run_seconds": _time.perf_counter() - t_start,

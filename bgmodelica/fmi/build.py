@@ -93,12 +93,16 @@ def zip_fmu(root: Path, fmu_path: Path) -> Path:
     fmu_path.parent.mkdir(parents=True, exist_ok=True)
     tmp = fmu_path.with_name(fmu_path.name + ".part")
     files = sorted(p for p in root.rglob("*") if p.is_file())
-    with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zf:
-        for path in files:
-            info = zipfile.ZipInfo(path.relative_to(root).as_posix(), ZIP_DATE)
-            info.compress_type = zipfile.ZIP_DEFLATED
-            info.external_attr = (0o755 if path.suffix in (".so", ".dylib", ".dll")
-                                  else 0o644) << 16
-            zf.writestr(info, path.read_bytes())
-    os.replace(tmp, fmu_path)
+    try:
+        with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zf:
+            for path in files:
+                info = zipfile.ZipInfo(path.relative_to(root).as_posix(), ZIP_DATE)
+                info.compress_type = zipfile.ZIP_DEFLATED
+                info.external_attr = (0o755 if path.suffix in (".so", ".dylib", ".dll")
+                                      else 0o644) << 16
+                zf.writestr(info, path.read_bytes())
+        os.replace(tmp, fmu_path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)      # no partial FMU
+        raise
     return fmu_path

@@ -14,7 +14,10 @@ C symbol                  signature                                             
 ``<id>_initfwd``          ``(t, u, p, du, dp) -> (dx0, dxdot0, dy0)`` (total)         init dd
 ========================  ==========================================================  =========
 
-The last two exist only when the spec has an ``init`` function.  Internal CasADi helpers carry
+The last two exist only when the spec has an ``init`` function.  A hybrid spec (models with
+events) passes the discrete slots ``d`` as the last argument of every function and adds the
+event functions ``<id>_evstep``, ``<id>_evind`` and ``<id>_evsamp`` (see
+:mod:`bgmodelica.fmi.hybrid`).  Internal CasADi helpers carry
 the prefix ``<id>_cg_`` and every symbol is compiled with hidden visibility, so several FMUs
 never clash.  The structural dependencies used by ``modelDescription.xml`` are computed here
 too, from the Jacobian sparsity of the same functions.
@@ -23,7 +26,7 @@ too, from the Jacobian sparsity of the same functions.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import casadi as ca
@@ -41,10 +44,11 @@ class ModelFunctions:
     xdot: ca.Function
     init: ca.Function | None
     initfwd: ca.Function | None
+    events: list[ca.Function] = field(default_factory=list)   # hybrid specs only
 
     def all(self) -> list[ca.Function]:
         return [f for f in (self.ode, self.fwd, self.jacx, self.xdot, self.init, self.initfwd)
-                if f is not None]
+                if f is not None] + list(self.events)
 
 
 @dataclass
@@ -87,18 +91,30 @@ def build_functions(spec: FmuSpec, prefix: str) -> ModelFunctions:
     dx = ca.MX.sym("dx", nx)
     du = ca.MX.sym("du", nu)
     dp = ca.MX.sym("dp", np_)
-    xdot, y = _call(spec.ode, [t, x, u, p])
-    ode = ca.Function(f"{prefix}ode", [t, x, u, p], [xdot, y],
-                      ["t", "x", "u", "p"], ["xdot", "y"])
+    hyb = spec.hybrid
+    # hybrid: the discrete slots d are the last argument of every function
+    ds = [ca.MX.sym("d", hyb.nd)] if hyb is not None else []
+    dn = ["d"] * len(ds)
+    xdot, y = _call(spec.ode, [t, x, u, p] + ds)
+    ode = ca.Function(f"{prefix}ode", [t, x, u, p] + ds, [xdot, y],
+                      ["t", "x", "u", "p"] + dn, ["xdot", "y"])
     both = ca.vertcat(xdot, y)
     seed = ca.vertcat(dx, du, dp)
     sens = ca.densify(ca.jtimes(both, ca.vertcat(x, u, p), seed))
-    fwd = ca.Function(f"{prefix}fwd", [t, x, u, p, dx, du, dp], [sens[:nx], sens[nx:]],
-                      ["t", "x", "u", "p", "dx", "du", "dp"], ["dxdot", "dy"])
-    jacx = _pruned(ca.Function(f"{prefix}jacx", [t, x, u, p],
-                               [ca.densify(ca.jacobian(xdot, x))], ["t", "x", "u", "p"], ["J"]))
-    xdot_only = _pruned(ca.Function(f"{prefix}xdot", [t, x, u, p], [xdot],
-                                    ["t", "x", "u", "p"], ["xdot"]))
+    fwd = ca.Function(f"{prefix}fwd", [t, x, u, p, dx, du, dp] + ds, [sens[:nx], sens[nx:]],
+                      ["t", "x", "u", "p", "dx", "du", "dp"] + dn, ["dxdot", "dy"])
+    jacx = _pruned(ca.Function(f"{prefix}jacx", [t, x, u, p] + ds,
+                               [ca.densify(ca.jacobian(xdot, x))], ["t", "x", "u", "p"] + dn,
+                               ["J"]))
+    xdot_only = _pruned(ca.Function(f"{prefix}xdot", [t, x, u, p] + ds, [xdot],
+                                    ["t", "x", "u", "p"] + dn, ["xdot"]))
+    events = []
+    if hyb is not None:
+        for f in (hyb.step, hyb.indicators, hyb.samples):
+            outs = _call(f, [t, x, u, p] + ds)
+            events.append(_pruned(ca.Function(
+                f"{prefix}{f.name()}", [t, x, u, p] + ds, outs, ["t", "x", "u", "p"] + dn,
+                [f.name_out(i) for i in range(f.n_out())])))
     init = initfwd = None
     if spec.init is not None:
         (x0,) = _call(spec.init, [t, u, p])
@@ -109,7 +125,7 @@ def build_functions(spec: FmuSpec, prefix: str) -> ModelFunctions:
         initfwd = ca.Function(f"{prefix}initfwd", [t, u, p, du, dp],
                               [sens0[:nx], sens0[nx:2 * nx], sens0[2 * nx:]],
                               ["t", "u", "p", "du", "dp"], ["dx0", "dxdot0", "dy0"])
-    return ModelFunctions(ode, fwd, jacx, xdot_only, init, initfwd)
+    return ModelFunctions(ode, fwd, jacx, xdot_only, init, initfwd, events)
 
 
 def _pruned(f: ca.Function) -> ca.Function:

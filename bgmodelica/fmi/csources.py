@@ -10,6 +10,8 @@ The directory holds everything needed to rebuild the binary with any C99 compile
   ``fmi<v>_common.c``, ``fmi<v>_me.c``, ``fmi<v>_cs.c`` (all three are always compiled so every
   function of the standard exists in the binary; an interface type that the modelDescription
   does not declare refuses to instantiate);
+* hybrid models (events) add ``bgm_events.[ch]`` (the event runtime) and the generated
+  ``bgm_hybrid_data.c`` (its tables, see :mod:`bgmodelica.fmi.hybrid`);
 * the official FMI headers of the version, copied from the ``fmpy`` package
   (``fmpy/c-code``), which ships them under the 2-clause BSD license of the Modelica
   Association.
@@ -28,6 +30,7 @@ from .variables import SOLVER_TOLERANCE_MAX, SOLVER_TOLERANCE_MIN, VariableTable
 TEMPLATES = Path(__file__).parent / "templates"
 
 RUNTIME_FILES = ("bgm_core.h", "bgm_core.c", "bgm_solver.c")
+HYBRID_FILES = ("bgm_events.h", "bgm_events.c")
 WRAPPER_FILES = {2: ("fmi2_common.c", "fmi2_me.c", "fmi2_cs.c"),
                  3: ("fmi3_common.c", "fmi3_me.c", "fmi3_cs.c")}
 FMI_HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
@@ -112,6 +115,10 @@ def model_data_sources(spec: FmuSpec, table: VariableTable, version: int, token:
     if has_init:
         lines += [f"#define BGM_CASADI_INIT {prefix}init",
                   f"#define BGM_CASADI_INITFWD {prefix}initfwd"]
+    if spec.hybrid is not None:
+        from .hybrid import header_lines
+
+        lines += header_lines(spec.hybrid, prefix, len(table.of_kind("indicator")))
     lines += ["#endif", ""]
     header = "\n".join(lines)
 
@@ -135,12 +142,18 @@ def model_data_sources(spec: FmuSpec, table: VariableTable, version: int, token:
         "const char *const bgm_var_names[BGM_NVR] = {\n    "
         + ",\n    ".join(_c_string(v.name) for v in table.variables) + "\n};\n",
     ]
-    return {"bgm_model_data.h": header, "bgm_model_data.c": "\n".join(body)}
+    out = {"bgm_model_data.h": header, "bgm_model_data.c": "\n".join(body)}
+    if spec.hybrid is not None:
+        from .hybrid import data_source
+
+        out["bgm_hybrid_data.c"] = data_source(spec.hybrid, spec.model_name)
+    return out
 
 
-def write_runtime(version: int, dest: Path) -> list[str]:
+def write_runtime(version: int, dest: Path, hybrid: bool = False) -> list[str]:
     """Copy the runtime templates and the FMI headers; return the copied file names."""
-    names = list(RUNTIME_FILES) + list(WRAPPER_FILES[version])
+    names = list(RUNTIME_FILES) + list(HYBRID_FILES if hybrid else ()) \
+        + list(WRAPPER_FILES[version])
     for name in names:
         shutil.copyfile(TEMPLATES / name, dest / name)
     return names + copy_fmi_headers(version, dest)

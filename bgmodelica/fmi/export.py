@@ -49,7 +49,8 @@ def export_fmu(spec: FmuSpec, out_dir: str | Path, fmi_version: int = 2,
     prefix = codegen.symbol_prefix(ident)
     funcs = codegen.build_functions(spec, prefix)
     deps = codegen.dependencies(spec, funcs)
-    table = build_table(spec, with_solver="cs" in interfaces)
+    table = build_table(spec, with_solver="cs" in interfaces,
+                        with_indicators=fmi_version == 3 and "me" in interfaces)
 
     with tempfile.TemporaryDirectory(prefix="bgm_fmu_") as tmp:
         root = Path(tmp) / "fmu"
@@ -57,7 +58,7 @@ def export_fmu(spec: FmuSpec, out_dir: str | Path, fmi_version: int = 2,
         src.mkdir(parents=True)
         model_base = f"{prefix}model"
         codegen.generate_c(funcs, src, model_base, prefix)
-        write_runtime(fmi_version, src)
+        write_runtime(fmi_version, src, hybrid=spec.hybrid is not None)
         token = instantiation_token(
             str(fmi_version), fmu_type, ident, repr(table.variables),
             (src / f"{model_base}.c").read_text(), _runtime_digest(),

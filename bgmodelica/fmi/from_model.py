@@ -7,16 +7,24 @@ values, so the FMU sees ``xdot, y = ode(t, x, u, p)``.
 Causality: the model's top-level ``Output`` variables are FMU outputs; the states are the FMU's
 continuous states; every other variable, aliases included, is a local. Free parameters are tunable
 parameters and top-level ``Input`` variables are inputs.
+
+Ranges: the ``min``/``max`` of the declarations (``Parameter(..., min=, max=)``,
+``Variable(..., min=, max=)``) go to ``modelDescription.xml`` for parameters, inputs, states,
+outputs and locals (an alias gets the range of the variable it stands for, mirrored when the
+sign is negative); the FMU refuses parameter, input and state start values outside them. A
+default value outside its own range is refused at export (:class:`FmuSpecError`); a
+consistent initial state within 1e-9 (relative) of a bound is put on the bound.
 """
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import casadi as ca
 import numpy as np
 
-from ..backends.casadi_init import initialize
+from ..backends.casadi_init import initial_state_function, initialize
 from ..compiler import CompiledModel, compile
 from ..core.component import Component
 from ..core.variables import KIND_OUTPUT
@@ -24,33 +32,81 @@ from .export import export_fmu
 from .spec import FmuSpec, FmuSpecError, ScalarVariable
 
 
+def _bounds(decl: object, name: str, kind: str) -> tuple[float | None, float | None]:
+    """``(min, max)`` of a declaration as floats (None: not declared or infinite)."""
+    out: list[float | None] = []
+    for attr in ("min", "max"):
+        b = getattr(decl, attr, None)
+        if b is None:
+            out.append(None)
+            continue
+        try:
+            x = float(b)
+        except (TypeError, ValueError):
+            raise FmuSpecError(f"{kind} {name!r}: {attr}={b!r} is not a number") from None
+        if math.isnan(x):
+            raise FmuSpecError(f"{kind} {name!r}: {attr} is NaN")
+        out.append(x if math.isfinite(x) else None)
+    lo, hi = out
+    if lo is not None and hi is not None and lo > hi:
+        raise FmuSpecError(f"{kind} {name!r}: min {lo:g} > max {hi:g}")
+    return lo, hi
+
+
+def _on_bound(value: float, lo: float | None, hi: float | None, name: str) -> float:
+    """A state's initial value, put on a bound it misses by rounding only."""
+    for b, below in ((lo, True), (hi, False)):
+        if b is None or (value >= b if below else value <= b):
+            continue
+        if abs(value - b) <= 1e-9 * max(1.0, abs(b)):
+            return b
+        raise FmuSpecError(f"state {name!r}: its consistent initial value {value:g} is outside "
+                           f"its declared range [{'-inf' if lo is None else f'{lo:g}'}, "
+                           f"{'inf' if hi is None else f'{hi:g}'}]")
+    return value
+
+
 def fmu_spec(model: Component | CompiledModel, *, stop_time: float = 1.0,
              step_size: float | None = None, tolerance: float = 1e-6,
-             newton_tolerance: float = 1e-12) -> FmuSpec:
-    """Describe a model for export (see the module docstring for the conventions)."""
+             newton_tolerance: float = 1e-12, static_states: bool = False) -> FmuSpec:
+    """Describe a model for export (see the module docstring for the conventions).
+
+    A model whose state choice must change during a simulation (dynamic state selection,
+    e.g. the Cartesian pendulum) is refused: the FMU runtime keeps the compiled choice, which
+    degenerates. ``static_states=True`` exports it anyway, for motions known to stay where the
+    compiled states are valid."""
     compiled = model if isinstance(model, CompiledModel) else compile(model)
     dae = compiled.dae
-    if dae.hybrid is not None:
-        ev = compiled.event_summary() or {}
-        what = [c["relation"] for c in ev.get("conditions", [])[:3]]
-        what += ["when-clauses"] * bool(ev.get("when_clauses"))
-        what += ["sample clocks"] * bool(ev.get("clocks"))
-        what += ["time tables"] * bool(ev.get("tables"))
+    hybrid = dae.hybrid is not None      # events: see bgmodelica.fmi.hybrid
+    if hybrid:
+        from .hybrid import check_exportable
+
+        check_exportable(dae, compiled.name)
+    if not static_states and compiled.needs_dynamic_selection():
         raise FmuSpecError(
-            f"cannot export {compiled.name} as an FMU yet: it has events ("
-            + ", ".join(what) + "); the FMU runtime does not handle events, so the FMU "
-            "would be wrong. Simulate it natively, or wrap relations that need no event in "
-            "no_event()")
+            f"cannot export {compiled.name} as an FMU: it needs dynamic state selection (its "
+            f"states {', '.join(dae.state_names)} are valid only in part of the motion, see "
+            "`bgmodelica check`), which the FMU runtime does not carry, so the FMU would go "
+            "wrong when they degenerate. Give states valid everywhere with state_select, or "
+            "export with static_states=True (--static-states) if the motion stays where "
+            "they are valid")
     flat = compiled.reduced.model
     n_par = len(dae.parameters)
     p_all = dae.p_default
-    init = initialize(dae, p_all)
+    if hybrid:
+        from .hybrid import consistent_start
+
+        x_init, z_init, p_init = consistent_start(dae, p_all)
+    else:
+        init = initialize(dae, p_all)
+        x_init, z_init, p_init = init.x0, init.z0, p_all
 
     t = ca.MX.sym("t")
     x = ca.MX.sym("x", dae.x.numel())
     u = ca.MX.sym("u", len(dae.inputs))
     p = ca.MX.sym("p", n_par)
-    pu = ca.vertcat(p, u)
+    d = ca.MX.sym("d", len(dae.discretes)) if hybrid else None
+    pu = ca.vertcat(p, u, d) if hybrid else ca.vertcat(p, u)
 
     by_name = {v.name: v for v in flat.variables}
     declared_outputs = [v.name for v in flat.variables
@@ -63,10 +119,13 @@ def fmu_spec(model: Component | CompiledModel, *, stop_time: float = 1.0,
     states = set(dae.state_names)
     output_names = [n for n in declared_outputs if n not in states]
     taken = states | set(output_names)
-    local_names = [n for n in dae.names if by_name[n].der_of < 0 and n not in taken]
+    # discrete variables are exported apart, with their FMI types (hybrid models)
+    discrete = set(dae.discrete_names) | {q.name for q in dae.discretes}
+    local_names = [n for n in dae.names
+                   if n not in discrete and by_name[n].der_of < 0 and n not in taken]
     alias_names = [a for a, (rep, _) in sorted(flat.aliases.items())
-                   if rep in dae.observed_index and by_name[rep].der_of < 0
-                   and not a.startswith("der(") and a not in taken]
+                   if rep in dae.observed_index and rep not in discrete
+                   and by_name[rep].der_of < 0 and not a.startswith("der(") and a not in taken]
 
     def observed(n: str) -> ca.SX:
         # a declared output may be an alias (e.g. of a state): export it as an output anyway
@@ -77,45 +136,93 @@ def fmu_spec(model: Component | CompiledModel, *, stop_time: float = 1.0,
 
     y_sx = ca.vertcat(*[observed(n) for n in output_names + local_names + alias_names])
     f_sx = ca.Function("model", [dae.t, dae.x, dae.z, dae.p], [dae.ode, y_sx])
+    z_of = None
     if dae.z.numel():
         g = ca.Function("g", [dae.z, ca.vertcat(dae.t, dae.x, dae.p)], [dae.alg])
         solver = ca.rootfinder("loops", "fast_newton", g,
                                {"abstol": newton_tolerance, "max_iter": 50})
-        z = solver(ca.DM(init.z0), ca.vertcat(t, x, pu))
+
+        def z_of(t_, x_, p_):
+            return solver(ca.DM(z_init), ca.vertcat(t_, x_, p_))
+
+        z = z_of(t, x, pu)
     else:
         z = ca.MX(0, 1)
     xdot, y = f_sx(t, x, z, pu)
-    ode = ca.Function("ode", [t, x, u, p], [xdot, y], ["t", "x", "u", "p"], ["xdot", "y"])
+    ds, dn = ([d], ["d"]) if hybrid else ([], [])
+    ode = ca.Function("ode", [t, x, u, p] + ds, [xdot, y], ["t", "x", "u", "p"] + dn,
+                      ["xdot", "y"])
 
-    def scalar(name: str, start: float) -> ScalarVariable:
+    def scalar(name: str, start: float, kind: str = "variable") -> ScalarVariable:
         v = by_name.get(name)
         decl = v.decl if v is not None else top_decls.get(name)
+        lo, hi = _bounds(decl, name, kind)
+        if kind == "state":
+            start = _on_bound(float(start), lo, hi, name)
         return ScalarVariable(name, float(start), getattr(decl, "unit", "") or "",
-                              getattr(decl, "description", "") or "")
+                              getattr(decl, "description", "") or "", min=lo, max=hi)
 
-    y0 = np.asarray(ca.Function("y0", [t, x, u, p], [y])(
-        0.0, init.x0, p_all[n_par:], p_all[:n_par])).ravel()
+    def alias(a: str, start: float) -> ScalarVariable:
+        rep, sign = flat.aliases[a]
+        decl = by_name[rep].decl
+        lo, hi = _bounds(decl, rep, "variable")
+        if sign < 0:
+            lo, hi = (None if hi is None else -hi), (None if lo is None else -lo)
+        return ScalarVariable(a, float(start), getattr(decl, "unit", "") or "", min=lo,
+                              max=hi)
+
+    n_base = dae.n_base
+    y0 = np.asarray(ca.Function("y0", [t, x, u, p] + ds, [y])(
+        0.0, x_init, p_init[n_par:n_base], p_init[:n_par],
+        *([p_init[n_base:]] if hybrid else []))).ravel()
     n_out = len(output_names)
     outputs = [scalar(n, y0[k]) for k, n in enumerate(output_names)]
     locals_ = [scalar(n, y0[n_out + k]) for k, n in enumerate(local_names)]
-    locals_ += [ScalarVariable(a, float(y0[n_out + len(local_names) + k]),
-                               getattr(by_name[flat.aliases[a][0]].decl, "unit", "") or "")
-                for k, a in enumerate(alias_names)]
-    state_vars = [scalar(n, init.x0[k]) for k, n in enumerate(dae.state_names)]
+    locals_ += [alias(a, y0[n_out + len(local_names) + k]) for k, a in enumerate(alias_names)]
+    state_vars = [scalar(n, x_init[k], "state") for k, n in enumerate(dae.state_names)]
     params = [ScalarVariable(q.name, float(p_all[k]), q.decl.unit or "",
-                             q.decl.description or "") for k, q in enumerate(dae.parameters)]
+                             q.decl.description or "", *_bounds(q.decl, q.name, "parameter"))
+              for k, q in enumerate(dae.parameters)]
     inputs = [ScalarVariable(q.name, float(p_all[n_par + k]), q.decl.unit or "",
-                             q.decl.description or "") for k, q in enumerate(dae.inputs)]
+                             q.decl.description or "", *_bounds(q.decl, q.name, "input"))
+              for k, q in enumerate(dae.inputs)]
     name = "".join(c if c.isalnum() or c == "_" else "_" for c in compiled.name) or "model"
+    hyb_spec = None
+    if hybrid:
+        from .hybrid import build_hybrid
+
+        if initial_state_function(dae, p_all) is not None:
+            raise FmuSpecError(
+                f"cannot export {compiled.name} as an FMU: its initial state follows from "
+                "conditions through the model's equations (fixed start values of non-states "
+                "or initial equations), which the event runtime of the FMU does not solve "
+                "yet; fix the start values of the states instead")
+        hyb_spec = build_hybrid(dae, flat, by_name, z_of,
+                                lambda p_, u_, d_: ca.vertcat(p_, u_, d_))
     return FmuSpec(model_name=name, description=f"{compiled.name} (bgmodelica)",
                    states=state_vars, inputs=inputs, parameters=params, outputs=outputs,
-                   locals=locals_, ode=ode, init=None, stop_time=stop_time,
-                   step_size=step_size, tolerance=tolerance)
+                   locals=locals_, ode=ode,
+                   init=None if hybrid else _init_function(dae, p_all, t, u, p),
+                   stop_time=stop_time,
+                   step_size=step_size, tolerance=tolerance, hybrid=hyb_spec)
+
+
+def _init_function(dae, p_all, t, u, p) -> ca.Function | None:
+    """``(t, u, p) -> x0`` when the initial state follows from conditions through the model's
+    equations (fixed start values of non-states), so that parameters set in the FMU change it
+    exactly as in native simulation; None when the initial state is the fixed start values."""
+    f0 = initial_state_function(dae, p_all)
+    if f0 is None:
+        return None
+    return ca.Function("init", [t, u, p], [f0(t, ca.vertcat(p, u))], ["t", "u", "p"], ["x0"])
 
 
 def export_model(model: Component | CompiledModel, out_dir: str | Path, *,
                  fmi_version: int = 2, fmu_type: str = "me", stop_time: float = 1.0,
-                 step_size: float | None = None, tolerance: float = 1e-6) -> Path:
-    """Compile (if needed) and export ``model`` as an FMU into ``out_dir``; returns its path."""
-    spec = fmu_spec(model, stop_time=stop_time, step_size=step_size, tolerance=tolerance)
+                 step_size: float | None = None, tolerance: float = 1e-6,
+                 static_states: bool = False) -> Path:
+    """Compile (if needed) and export ``model`` as an FMU into ``out_dir``; returns its path
+    (``static_states``: see :func:`fmu_spec`)."""
+    spec = fmu_spec(model, stop_time=stop_time, step_size=step_size, tolerance=tolerance,
+                    static_states=static_states)
     return export_fmu(spec, out_dir, fmi_version=fmi_version, fmu_type=fmu_type)

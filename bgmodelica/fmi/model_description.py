@@ -12,6 +12,12 @@ dependencies from the CasADi sparsity (:func:`bgmodelica.fmi.codegen.dependencie
   and ``<InitialUnknown>`` follow the same rules.
 
 Dotted names are kept as they are (``variableNamingConvention="structured"``).
+
+Hybrid specs (models with events): discrete variables get their FMI type (Real/Float64,
+Integer/Int32, Boolean); Model Exchange declares the event indicators
+(``numberOfEventIndicators`` in FMI 2.0, ``<EventIndicator>`` elements referring to the
+indicator variables in FMI 3.0); FMI 3.0 Co-Simulation may return early from ``fmi3DoStep``
+(at events, when the importer allows it); the log category ``logEvents`` reports events.
 """
 
 from __future__ import annotations
@@ -61,9 +67,10 @@ def _units(table: VariableTable, parent: ET.Element) -> None:
         ET.SubElement(unit, "BaseUnit", attrs)
 
 
-def _log_categories(parent: ET.Element) -> None:
+def _log_categories(parent: ET.Element, hybrid: bool = False) -> None:
     lc = ET.SubElement(parent, "LogCategories")
-    for name, description in LOG_CATEGORIES:
+    extra = (("logEvents", "Events (time, state and sample events) and event iterations"),)
+    for name, description in LOG_CATEGORIES + (extra if hybrid else ()):
         ET.SubElement(lc, "Category", name=name, description=description)
 
 
@@ -101,7 +108,18 @@ def _type_attrs(v: FmiVariable, version: int, table: VariableTable) -> dict[str,
         attrs["nominal"] = _num(v.nominal)
     if v.start is not None:
         attrs["start"] = _num(v.start)
+    if v.type == "Integer":
+        attrs.pop("unit", None)
+        for key in ("min", "max", "start"):
+            if key in attrs:
+                attrs[key] = str(int(round(float(attrs[key]))))
+    elif v.type == "Boolean":
+        attrs = {"start": "true" if v.start else "false"} if v.start is not None else {}
     return attrs
+
+
+_TYPE_ELEMENTS = {2: {"Real": "Real", "Integer": "Integer", "Boolean": "Boolean"},
+                  3: {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean"}}
 
 
 def _structure_entries(table: VariableTable, deps: Dependencies, has_init: bool):
@@ -151,8 +169,10 @@ def model_description_xml(spec: FmuSpec, table: VariableTable, deps: Dependencie
         root.set("description", spec.description)
     root.set("generationTool", GENERATION_TOOL)
     root.set("variableNamingConvention", "structured")
+    hybrid = spec.hybrid is not None
     if version == 2:
-        root.set("numberOfEventIndicators", "0")
+        n_ind = spec.hybrid.nz if hybrid and "me" in interfaces else 0
+        root.set("numberOfEventIndicators", str(n_ind))
 
     if version == 2:
         caps = {"canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true",
@@ -175,21 +195,23 @@ def model_description_xml(spec: FmuSpec, table: VariableTable, deps: Dependencie
             ET.SubElement(root, "ModelExchange", modelIdentifier=model_identifier,
                           needsCompletedIntegratorStep="false", **caps)
         if "cs" in interfaces:
+            early = {"mightReturnEarlyFromDoStep": "true"} if hybrid else {}
             ET.SubElement(root, "CoSimulation", modelIdentifier=model_identifier,
                           canHandleVariableCommunicationStepSize="true",
-                          maxOutputDerivativeOrder="0", hasEventMode="true", **caps)
+                          maxOutputDerivativeOrder="0", hasEventMode="true", **early, **caps)
 
     _units(table, root)
-    _log_categories(root)
+    _log_categories(root, hybrid)
     _experiment(spec, root)
 
     mv = ET.SubElement(root, "ModelVariables")
     for v in table.variables:
+        element = _TYPE_ELEMENTS[version][v.type]
         if version == 2:
             sv = ET.SubElement(mv, "ScalarVariable", _common_attrs(v))
-            ET.SubElement(sv, "Real", _type_attrs(v, 2, table))
+            ET.SubElement(sv, element, _type_attrs(v, 2, table))
         else:
-            ET.SubElement(mv, "Float64", {**_common_attrs(v), **_type_attrs(v, 3, table)})
+            ET.SubElement(mv, element, {**_common_attrs(v), **_type_attrs(v, 3, table)})
 
     ms = ET.SubElement(root, "ModelStructure")
     entries = list(_structure_entries(table, deps, spec.init is not None))
@@ -211,6 +233,8 @@ def model_description_xml(spec: FmuSpec, table: VariableTable, deps: Dependencie
             for _, var, dep in (e for e in entries if e[0] == kind):
                 ET.SubElement(ms, tags[kind], valueReference=str(var.vr),
                               dependencies=" ".join(str(d.vr) for d in dep))
+        for var in table.of_kind("indicator"):
+            ET.SubElement(ms, "EventIndicator", valueReference=str(var.vr))
 
     ET.indent(root, space="  ")
     return _serialize(root)

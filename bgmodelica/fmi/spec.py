@@ -21,8 +21,9 @@ Variables:
 * names are dotted Modelica-style names (``motor.inertia.w``); the derivative of state ``s`` is
   exported as ``der(s)`` automatically, so derivatives are *not* listed by the compiler;
 * ``unit`` is a Modelica unit string (``"rad/s"``, ``"N.m"``, ``"1"``, ``""`` for none);
-* ``min``/``max`` (optional) bound the values the FMU accepts for inputs, parameters and state
-  start values (outside: an error status);
+* ``min``/``max`` (optional) are written to ``modelDescription.xml`` for every variable; they
+  bound the values the FMU accepts for inputs, parameters and state start values (outside, or
+  NaN: an error status and a logged message naming the variable; nothing is set);
 * ``nominal`` (optional, states only) scales the absolute tolerance of integrators and is returned
   by ``GetNominalsOfContinuousStates``;
 * the ``start`` of outputs and locals is not exported (they are calculated).
@@ -89,6 +90,9 @@ class FmuSpec:
     step_size: float | None = None
     tolerance: float = 1e-6
     solver_max_step: float | None = None
+    #: models with events: a :class:`bgmodelica.fmi.hybrid.HybridSpec`; then ``ode`` takes the
+    #: discrete slots as a fifth argument ``(t, x, u, p, d)`` and ``init`` must be None
+    hybrid: Any = None
 
     @property
     def nx(self) -> int:
@@ -121,7 +125,10 @@ class FmuSpec:
             raise FmuSpecError(f"model_name {self.model_name!r} is longer than 64 characters")
         if self.ode is None:
             raise FmuSpecError("FmuSpec.ode is missing")
-        _check_function(self.ode, "ode", [1, self.nx, self.nu, self.np], [self.nx, self.ny])
+        n_in = [1, self.nx, self.nu, self.np] + ([self.hybrid.nd] if self.hybrid else [])
+        _check_function(self.ode, "ode", n_in, [self.nx, self.ny])
+        if self.hybrid is not None and self.init is not None:
+            raise FmuSpecError("a hybrid spec cannot have an init function")
         if self.init is not None:
             _check_function(self.init, "init", [1, self.nu, self.np], [self.nx])
         seen: dict[str, str] = {}
@@ -146,6 +153,8 @@ class FmuSpec:
                     raise FmuSpecError(f"{kind} {v.name!r}: start {v.start} outside [{lo}, {hi}]")
                 if v.nominal is not None and not (math.isfinite(v.nominal) and v.nominal > 0):
                     raise FmuSpecError(f"{kind} {v.name!r}: nominal must be finite and > 0")
+        if self.hybrid is not None:
+            self.hybrid.validate(self.nx, seen)
         for s in self.states:
             der = f"der({s.name})"
             if der in seen:

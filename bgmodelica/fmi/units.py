@@ -3,8 +3,9 @@
 A unit string is parsed with the Modelica unit grammar subset ``"1"``, ``factor('.'factor)*``
 optionally followed by ``'/' term`` (``"N.m"``, ``"kg.m2"``, ``"rad/s2"``, ``"1/s"``,
 ``"m/s"``), where a factor is a known symbol with an optional SI prefix and integer exponent.
-Unknown unit strings are still declared (without ``<BaseUnit>``) so the modelDescription stays
-valid.
+Anything else (parentheses as in ``"V/(rad.s)"``, ``"rpm"``, other units pint knows) is
+parsed with pint (:mod:`bgmodelica.core.units`). Unknown unit strings are still declared
+(without ``<BaseUnit>``) so the modelDescription stays valid.
 """
 
 from __future__ import annotations
@@ -98,6 +99,29 @@ def _term(term: str) -> tuple[dict[str, int], float, float, int] | None:
 
 def parse_unit(unit: str) -> UnitDefinition:
     """Return the :class:`UnitDefinition` of ``unit`` (``exponents=None`` if unknown)."""
+    out = _parse_simple(unit)
+    return out if out.exponents is not None or not unit else _parse_pint(unit)
+
+
+def _parse_pint(unit: str) -> UnitDefinition:
+    """Exponents over :data:`BASE` through pint, the angle counted from the symbols."""
+    from ..core.units import SI_SYMBOLS, UnitParseError, angle_exponent, parse
+
+    try:
+        u = parse(unit)
+    except UnitParseError:
+        return UnitDefinition(unit)
+    if any(d.denominator != 1 for d in u.dims):
+        return UnitDefinition(unit)
+    exps = {k: int(d) for k, d in zip(SI_SYMBOLS, u.dims, strict=True) if d}
+    rad = angle_exponent(unit)
+    if rad:
+        exps["rad"] = rad
+    # pint folds angles into the factor (deg = pi/180): keep it, as for "deg" above
+    return UnitDefinition(unit, exps, u.factor, u.offset)
+
+
+def _parse_simple(unit: str) -> UnitDefinition:
     parts = unit.split("/")
     if not unit or any(not p for p in parts):
         return UnitDefinition(unit)

@@ -49,6 +49,7 @@ class FmiVariable:
     max: float | None = None
     nominal: float | None = None
     derivative_of: int | None = None  # VR of the state, for derivatives
+    type: str = "Real"  # Real, Integer or Boolean (discrete variables of hybrid models)
 
     @property
     def fmi2_index(self) -> int:
@@ -100,8 +101,14 @@ def _opt(value: float | None) -> float | None:
     return float(value)
 
 
-def build_table(spec: FmuSpec, with_solver: bool) -> VariableTable:
-    """Lay out the variables of ``spec``; ``with_solver`` adds the CS solver parameters."""
+def build_table(spec: FmuSpec, with_solver: bool, with_indicators: bool = False
+                ) -> VariableTable:
+    """Lay out the variables of ``spec``; ``with_solver`` adds the CS solver parameters.
+
+    Hybrid specs add, after the solver parameters, their discrete variables (local,
+    ``variability="discrete"``, typed; ``initial="exact"`` with the declared start for those
+    assigned in when-clauses, ``"calculated"`` for those defined by equations) and, with
+    ``with_indicators`` (FMI 3.0 Model Exchange), one local Float64 per event indicator."""
     out: list[FmiVariable] = []
 
     def add(v: ScalarVariable | None, name: str, kind: str, index: int, causality: str,
@@ -133,10 +140,11 @@ def build_table(spec: FmuSpec, with_solver: bool) -> VariableTable:
         add(v, v.name, "parameter", i, "parameter", "tunable", "exact", float(v.start), v.unit,
             min=_opt(v.min), max=_opt(v.max))
     for i, v in enumerate(spec.outputs):
-        add(v, v.name, "output", i, "output", "continuous", "calculated", None, v.unit)
+        add(v, v.name, "output", i, "output", "continuous", "calculated", None, v.unit,
+            min=_opt(v.min), max=_opt(v.max))
     for i, v in enumerate(spec.locals):
         add(v, v.name, "local", len(spec.outputs) + i, "local", "continuous", "calculated",
-            None, v.unit)
+            None, v.unit, min=_opt(v.min), max=_opt(v.max))
     if with_solver:
         tol = add(None, "solver.tolerance", "solver", 0, "parameter", "tunable", "exact",
                   float(spec.tolerance), "1", min=SOLVER_TOLERANCE_MIN, max=SOLVER_TOLERANCE_MAX)
@@ -145,5 +153,20 @@ def build_table(spec: FmuSpec, with_solver: bool) -> VariableTable:
         hmax = add(None, "solver.max_step", "solver", 1, "parameter", "tunable", "exact",
                    float(spec.default_max_step()), "s", min=1e-12)
         hmax.description = "Largest internal step of the embedded solver (Co-Simulation)"
+    if spec.hybrid is not None:
+        from .hybrid import indicator_name
+
+        for i, dv in enumerate(spec.hybrid.discretes):
+            var = add(None, dv.name, "discrete", i, "local", "discrete",
+                      "calculated" if dv.start is None else "exact",
+                      None if dv.start is None else float(dv.start),
+                      dv.unit if dv.type == "Real" else "", type=dv.type)
+            var.description = dv.description
+        if with_indicators:
+            for k, r in enumerate(spec.hybrid.state_rel):
+                var = add(None, indicator_name(k), "indicator", k, "local", "continuous",
+                          "calculated", None)
+                var.description = (f"Event indicator of the relation "
+                                   f"{spec.hybrid.relations[r]} (> 0: true)")
     return VariableTable(out, spec.nx, spec.nu, spec.np, len(spec.outputs), len(spec.locals),
                          with_solver)

@@ -63,6 +63,8 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
     residuals: list[ca.SX] = []
     hybrid = model.hybrid
     extra = hybrid.expressions() if hybrid is not None else []
+    n_init = len(model.initial_equations)          # substituted like the model's equations
+    extra = [eq.residual for eq in model.initial_equations] + extra
     if kept or extra:
         targets = ca.vertcat(*[eq.residual for eq in kept], *extra)
         if old:
@@ -70,8 +72,10 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
                                     ca.vertcat(*new_rep) * ca.DM(new_sign))
         parts = ca.vertsplit(targets) if targets.numel() > 1 else [targets]
         residuals = parts[:len(kept)]
+        initial = [FlatEquation(r, eq.origin) for r, eq in
+                   zip(parts[len(kept):len(kept) + n_init], model.initial_equations, strict=True)]
         if hybrid is not None:
-            hybrid = hybrid.with_expressions(parts[len(kept):])
+            hybrid = hybrid.with_expressions(parts[len(kept) + n_init:])
     equations = [FlatEquation(res, eq.origin) for res, eq in zip(residuals, kept, strict=True)]
     keep_idx = [i for i in range(len(new_vars)) if i not in eliminated]
     remap = {old_i: new_i for new_i, old_i in enumerate(keep_idx)}
@@ -79,8 +83,10 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
     for i in keep_idx:
         v = new_vars[i]
         final.append(replace(v, der=remap.get(v.der, -1), der_of=remap.get(v.der_of, -1)))
-    return FlatModel(model.name, final, model.parameters, model.inputs, equations, aliases,
-                     model.discretes, hybrid)
+    out = FlatModel(model.name, final, model.parameters, model.inputs, equations, aliases,
+                    model.discretes, hybrid)
+    out.initial_equations = initial if n_init else []
+    return out
 
 
 def _ensure_derivative(variables: list[FlatVariable], i: int) -> int:

@@ -13,6 +13,7 @@ from ..core.flatmodel import FlatModel
 from ..errors import UnbalancedModelError
 from ..structure.diagnosis import dulmage_mendelsohn
 from ..structure.matching import maximum_matching
+from .reference import likely_causes
 from .symbolic import incidence
 
 
@@ -66,6 +67,11 @@ def check_balance(model: FlatModel, max_listed: int = 12) -> BalanceReport:
             f"model {model.name} is structurally singular ({report.n_equations} equations and "
             "unknowns, but some equations constrain the same variables)")
     lines = [head]
+    causes = likely_causes(model, [unknowns[j] for j in dm.underdetermined_vars
+                                   if matching.var_to_eq[j] < 0], inc,
+                           [i for i in dm.overdetermined_eqs if matching.eq_to_var[i] < 0])
+    if causes:
+        lines.append("likely cause: " + "; ".join(causes[:3]))
     if missing:
         lines.append(f"no equation determines {len(missing)} variable(s):")
         lines += [f"  {m}" for m in missing[:max_listed]]

@@ -14,9 +14,9 @@ import casadi as ca
 
 from ..core.flatmodel import FlatEquation, FlatModel, FlatVariable
 from ..core.variables import TIME, Variable, derivative_unit
-from ..errors import EquationError, UnbalancedModelError
+from ..errors import EquationError, StateSelectError, UnbalancedModelError
 from ..structure import EquationGraph, dummy_derivatives, pantelides
-from ..structure.errors import StructuralError, StructurallySingular
+from ..structure.errors import StateSelectionError, StructuralError, StructurallySingular
 from .symbolic import incidence, time_derivative
 
 Selector = Callable[[int, list[int], list[int], list[int]], list[int]]
@@ -104,6 +104,15 @@ def reduce_index(model: FlatModel | ReducedModel,
     priority = [int(variables[base[j]].state_select) for j in range(len(variables))]
     try:
         dd = dummy_derivatives(exact, priority, select=select)
+    except StateSelectionError as err:
+        if select is not None or "cannot all be states" not in str(err):
+            raise UnbalancedModelError(f"state selection for {model.name} failed: {err}") \
+                from None
+        names = ", ".join(variables[j].origin for j in err.variables if j < len(variables))
+        raise StateSelectError(
+            f"{names} have StateSelect.ALWAYS but cannot all be states: equations of "
+            f"{model.name} constrain them (fewer states are possible); remove "
+            "StateSelect.ALWAYS from some of them") from None
     except StructuralError as err:
         raise UnbalancedModelError(f"state selection for {model.name} failed: {err}") from None
     return ReducedModel(aug, exact, list(dd.states), list(dd.dummies),

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import casadi as ca
 
+from ..diagnose import singular_linear_block
 from ..errors import EquationError, UnbalancedModelError
 from ..structure import block_lower_triangular, maximum_matching, tear
 from .index_reduction import ReducedModel
@@ -152,6 +153,17 @@ def _switches_on(e: ca.SX, var: ca.SX) -> bool:
     return False
 
 
+def _dependent(model, eqs: list[int], names: list[str]) -> UnbalancedModelError:
+    """A linear block whose equations are linearly dependent for every parameter value."""
+    shown = "; ".join(model.describe(e) for e in eqs[:4]) + ("; ..." if len(eqs) > 4 else "")
+    return UnbalancedModelError(
+        f"{model.name} is singular: the equations {shown} cannot determine "
+        f"{', '.join(names[:8])} (they are linearly dependent for every parameter value); "
+        "likely cause: ideal sources or storage elements that constrain each other (voltage "
+        "sources or capacitors in a loop, current sources or inductors in a cut)",
+        missing=list(names), surplus=[model.describe(e) for e in eqs])
+
+
 def _loop(out: SortedDAE, eqs, cols, eq_cols, res, sym, unknowns, names, variables,
           var_hashes: set[int]) -> None:
     cache: dict[tuple[int, int], ca.SX | None] = {}
@@ -175,6 +187,8 @@ def _loop(out: SortedDAE, eqs, cols, eq_cols, res, sym, unknowns, names, variabl
                                                 [ca.vertcat(*resid)], False)
         resid = [resid_sub[k] for k in range(resid_sub.numel())]
     solution = solve_linear_block(resid, [sym[c] for c in tear_cols]) if tear_cols else None
+    if solution is not None and singular_linear_block(resid, [sym[c] for c in tear_cols]):
+        raise _dependent(out.reduced.model, eqs, names)
     if solution is not None or not tear_cols:
         for k, c in enumerate(tear_cols):
             out.assignments.append((unknowns[c], solution[k]))

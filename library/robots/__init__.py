@@ -35,7 +35,8 @@ from typing import Any
 #: ``library.robots.lagrange`` stays importable without CasADi or the component library).
 _EXPORTS = {"RobotPID": ".robot", "RobotOpenLoop": ".robot", "RobotComputedTorque": ".robot",
             "RobotDigitalPID": ".digital", "DigitalJointPID": ".digital",
-            "TwoLinkArm": ".arm", "ArmWithTorques": ".arm", "DCMotor": ".motor"}
+            "TwoLinkArm": ".arm", "ArmWithTorques": ".arm", "DCMotor": ".motor",
+            "RobotJointPID": ".linear_control"}
 
 __all__ = sorted(_EXPORTS)
 

@@ -20,6 +20,7 @@ from __future__ import annotations
 import json
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -165,22 +166,39 @@ def digital_figure(res_continuous, outdir: Path, stop_time: float = 2.0,
     return path, info
 
 
-def run(outdir: Path) -> dict:
-    """Simulate the PID robot for 10 s; write CSV, figures and summary into ``outdir``."""
+def run(outdir: Path, stage: Callable[[str, float, str], None] | None = None) -> dict:
+    """Simulate the PID robot for 10 s; write CSV, figures and summary into ``outdir``.
+
+    ``stage(name, seconds, what)`` is called after each stage (simulation, figures, sampled
+    PID); by default it prints one line per stage.
+    """
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
+    if stage is None:
+        def stage(name: str, seconds: float, what: str = "") -> None:
+            print(f"{name}: {what} ({seconds:.1f} s)", flush=True)
+    t0 = time.perf_counter()
     compiled, res, build = simulate_robot()
     after = res.time >= SETTLE
     csv_path = res.to_csv(outdir / "robot.csv", CSV_COLUMNS)
+    err = {f"q{j}": float(np.max(np.abs(res[f"e{j}"][after]))) for j in (1, 2)}
+    stage("robot simulation", time.perf_counter() - t0,
+          f"RobotPID 10 s, max |q* - q| after {SETTLE:g} s: joint 1 {err['q1']:.4g} rad, "
+          f"joint 2 {err['q2']:.4g} rad; compile {build:.2f} s, simulate "
+          f"{float(res.meta['run_seconds']):.2f} s -> {csv_path}")
+    t0 = time.perf_counter()
     figures = _figures(res, outdir)
+    stage("figures", time.perf_counter() - t0, ", ".join(p.name for p in figures))
+    t0 = time.perf_counter()
     digital_path, digital = digital_figure(res, outdir)
     figures.append(digital_path)
+    stage("sampled PID", time.perf_counter() - t0,
+          f"RobotDigitalPID 2 s, {digital['events']:.0f} events -> {digital_path.name}")
     info = compiled.summary()
     summary = {
         "model": "library.robots.robot.RobotPID",
         "stop_time_s": STOP_TIME,
-        "max_abs_tracking_error_after_1s_rad": {
-            f"q{j}": float(np.max(np.abs(res[f"e{j}"][after]))) for j in (1, 2)},
+        "max_abs_tracking_error_after_1s_rad": err,
         "max_abs_voltage_V": {f"motor{j}": float(np.max(np.abs(res[f"motor{j}.u"])))
                               for j in (1, 2)},
         "max_abs_current_A": {f"motor{j}": float(np.max(np.abs(res[f"motor{j}.i"])))
@@ -198,11 +216,6 @@ def run(outdir: Path) -> dict:
         "figures": [str(p) for p in figures],
     }
     (outdir / "summary.json").write_text(json.dumps(summary, indent=2))
-    err = summary["max_abs_tracking_error_after_1s_rad"]
-    print(f"robot (PID): max |q* - q| after {SETTLE:g} s: joint 1 {err['q1']:.4g} rad, "
-          f"joint 2 {err['q2']:.4g} rad; compile {build:.3f} s, "
-          f"simulate {summary['run_seconds']:.3f} s ({summary['solver_steps']} steps); "
-          f"outputs in {outdir}")
     return summary
 
 

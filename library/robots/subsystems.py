@@ -308,8 +308,13 @@ class RobotFromSubsystems(Component):
     """The four subsystems connected back into one model (the connections of the SSP
     set-up). Simulated monolithically it equals :class:`RobotPID`: the split changes no
     physics. Parameters live in the subsystems (``arm.m1``, ``motor1.R``,
-    ``controller.Kp1``); the arm's ``Jd_k`` and ``d_k`` are bound to motor k's parameters.
+    ``controller.Kp1``); the arm's ``Jd_k = k2^2 Jm`` and ``d_k`` are bound to motor k's
+    parameters and to the rotor inertia ``Jm`` [kg.m2] (a parameter of this model: the motor
+    subsystems leave their rotor inertia to the arm).
     """
+
+    Jm = Parameter(MOTOR["Jm"], unit="kg.m2", description="Rotor inertia of both motors "
+                                                           "(lumped into the arm as k2^2 Jm)")
 
     def __init__(self, coupling: str = "lumped", name: str | None = None, **modifiers: Any):
         _check_coupling(coupling)
@@ -323,7 +328,7 @@ class RobotFromSubsystems(Component):
         mods: dict[str, Any] = {}
         for k in (1, 2):
             m = getattr(self, f"motor{k}")
-            mods[f"Jd{k}"] = reflected_inertia(MOTOR["Jm"], 1.0) * m.k2 ** 2
+            mods[f"Jd{k}"] = self.Jm * m.k2 ** 2
             mods[f"d{k}"] = m.k2 ** 2 * (m.k1 ** 2 / m.R + m.b) if coupling == "lumped" else 0.0
         self.arm.modify(**mods)
         if nested:

@@ -49,7 +49,8 @@ def test_unit_factors_offsets_and_unknown():
     assert parse_unit("km/h").factor == pytest.approx(1000 / 3600)
     assert parse_unit("deg").factor == pytest.approx(math.pi / 180)
     assert parse_unit("degC").offset == pytest.approx(273.15)
-    assert parse_unit("furlong").exponents is None
+    assert parse_unit("furlong").exponents == {"m": 1}          # through pint
+    assert parse_unit("blorf").exponents is None
     assert parse_unit("m//s").exponents is None
     assert derivative_unit("rad/s") == "rad/s2"
     assert derivative_unit("m") == "m/s"

@@ -43,6 +43,10 @@ static const bgm_function bgm_functions[] = {
 #if BGM_HAS_INIT
     BGM_FUNCTION(BGM_CASADI_INIT), BGM_FUNCTION(BGM_CASADI_INITFWD),
 #endif
+#if BGM_HYBRID
+    BGM_FUNCTION(BGM_CASADI_EVSTEP), BGM_FUNCTION(BGM_CASADI_EVIND),
+    BGM_FUNCTION(BGM_CASADI_EVSAMP),
+#endif
 };
 #define BGM_NFUN ((int)(sizeof(bgm_functions) / sizeof(bgm_functions[0])))
 
@@ -51,8 +55,22 @@ static int bgm_call(bgm_inst *c, int f, const double **args, int nargs, double *
     int i;
     for (i = 0; i < nargs; i++) c->arg[i] = args[i];
     for (i = 0; i < nouts; i++) c->res[i] = outs[i];
+#if BGM_HYBRID
+    c->arg[nargs] = c->v.h.d; /* the discrete slots are the last argument of every function */
+#endif
     return bgm_functions[f].eval(c->arg, c->res, c->iw, c->w, c->mem[f]);
 }
+
+#if BGM_HYBRID
+int bgm_call_event(bgm_inst *c, int which, double t, const double *x, double **outs, int nouts) {
+    const double *args[4];
+    args[0] = &t;
+    args[1] = x;
+    args[2] = c->v.u;
+    args[3] = c->v.p;
+    return bgm_call(c, 4 + 2 * BGM_HAS_INIT + which, args, 4, outs, nouts);
+}
+#endif
 
 static int bgm_all_finite(const double *v, size_t n) {
     size_t i;
@@ -113,7 +131,9 @@ void bgm_log(bgm_inst *c, int status, const char *category, const char *fmt, ...
     va_list ap;
     if (!c || !c->emit) return;
     if (status == BGM_OK) {
-        unsigned bit = strcmp(category, "logSolver") == 0 ? BGM_LOG_SOLVER : 0u;
+        unsigned bit = strcmp(category, "logSolver") == 0   ? BGM_LOG_SOLVER
+                       : strcmp(category, "logEvents") == 0 ? BGM_LOG_EVENTS
+                                                            : 0u;
         if (!c->logging_on || !(c->log_mask & bit)) return;
     }
     va_start(ap, fmt);
@@ -134,6 +154,7 @@ bgm_status bgm_set_debug_logging(bgm_inst *c, int on, size_t n, const char *cons
         if (cat && strcmp(cat, "logStatusWarning") == 0) mask |= BGM_LOG_WARNING;
         else if (cat && strcmp(cat, "logStatusError") == 0) mask |= BGM_LOG_ERROR;
         else if (cat && strcmp(cat, "logSolver") == 0) mask |= BGM_LOG_SOLVER;
+        else if (cat && strcmp(cat, "logEvents") == 0) mask |= BGM_LOG_EVENTS;
         else {
             bgm_error(c, "SetDebugLogging: unknown log category \"%s\"", cat ? cat : "(null)");
             return BGM_ERROR;
@@ -202,6 +223,9 @@ static void bgm_defaults(bgm_inst *c) {
     c->exp_tol = 0.0;
     c->stop_defined = 0;
     c->stop_time = 0.0;
+#if BGM_HYBRID
+    bgm_hyb_defaults(c);
+#endif
 }
 
 bgm_inst *bgm_new(int fmi_version, int kind, const char *name, int logging_on,
@@ -381,6 +405,9 @@ bgm_status bgm_eval_y(bgm_inst *c, const char *fn) { return bgm_evaluate(c, fn, 
 bgm_status bgm_exit_init(bgm_inst *c, const char *fn) {
     if (!bgm_check(c, fn, BGM_MODE_INIT)) return BGM_ERROR;
     c->cache_valid = 0;
+#if BGM_HYBRID
+    if (bgm_hyb_initialize(c, fn) != BGM_OK) return BGM_ERROR;
+#endif
     if (bgm_eval(c, fn) != BGM_OK) return BGM_ERROR;
     c->v.x0_done = 1;
     c->v.h_next = 0.0;
@@ -392,6 +419,9 @@ bgm_status bgm_exit_init(bgm_inst *c, const char *fn) {
 bgm_status bgm_terminate(bgm_inst *c, const char *fn) {
     if (!bgm_check(c, fn, BGM_MODE_INIT | BGM_MODE_EVENT | BGM_MODE_CONT | BGM_MODE_STEP))
         return BGM_ERROR;
+#if BGM_HYBRID
+    if (c->v.mode != BGM_MODE_INIT && bgm_hyb_terminate(c, fn) != BGM_OK) return BGM_ERROR;
+#endif
     c->v.mode = BGM_MODE_TERMINATED;
     if (c->v.kind == BGM_KIND_CS)
         bgm_log(c, BGM_OK, "logSolver",
@@ -426,16 +456,29 @@ int bgm_classify(unsigned vr, size_t *index) {
         *index = vr - BGM_VR_Y;
         return BGM_VAR_OUTPUT;
     }
-    if (vr >= BGM_VR_SOLVER && vr < BGM_NVR) {
+    if (vr >= BGM_VR_SOLVER && vr < BGM_VR_SOLVER + BGM_NSOLVER) {
         *index = vr - BGM_VR_SOLVER;
         return BGM_VAR_SOLVER;
     }
+#if BGM_HYBRID
+    if (vr >= BGM_VR_D && vr < BGM_VR_Z) {
+        *index = vr - BGM_VR_D;
+        return BGM_VAR_DISCRETE;
+    }
+    if (vr >= BGM_VR_Z && vr < BGM_NVR) {
+        *index = vr - BGM_VR_Z;
+        return BGM_VAR_INDICATOR;
+    }
+#endif
     return BGM_VAR_NONE;
 }
 
 bgm_status bgm_get_real(bgm_inst *c, const char *fn, const unsigned vr[], size_t n,
                         double values[]) {
     size_t k, i;
+#if BGM_HYBRID
+    int evaluated = 0;
+#endif
     if (!bgm_check(c, fn, BGM_MODE_ANY)) return BGM_ERROR;
     if (n == 0) return BGM_OK;
     if (!vr || !values) {
@@ -460,6 +503,14 @@ bgm_status bgm_get_real(bgm_inst *c, const char *fn, const unsigned vr[], size_t
             values[k] = c->y[i];
             break;
         case BGM_VAR_SOLVER: values[k] = i == 0 ? c->v.solver_tol : c->v.solver_hmax; break;
+#if BGM_HYBRID
+        case BGM_VAR_DISCRETE:
+        case BGM_VAR_INDICATOR:
+            if (bgm_hyb_value(c, fn, bgm_classify(vr[k], &i), i, BGM_DV_REAL, &evaluated,
+                              &values[k]) != BGM_OK)
+                return BGM_ERROR;
+            break;
+#endif
         default:
             bgm_error(c, "%s: unknown value reference %u", fn, vr[k]);
             return BGM_ERROR;
@@ -476,6 +527,9 @@ static int bgm_check_set(bgm_inst *c, const char *fn, unsigned vr, double value)
     int allowed = 0;
     const char *what = "";
     switch (kind) {
+#if BGM_HYBRID
+    case BGM_VAR_DISCRETE: return bgm_hyb_check_set(c, fn, i, BGM_DV_REAL, value);
+#endif
     case BGM_VAR_STATE:
         what = "a state";
 #if BGM_HAS_INIT
@@ -524,12 +578,18 @@ static int bgm_check_set(bgm_inst *c, const char *fn, unsigned vr, double value)
         return 0;
     }
     if (!isfinite(value)) {
-        bgm_error(c, "%s: value %g for %s is not finite", fn, value, bgm_var_names[vr]);
+        bgm_error(c, "%s: value %g for %s is not finite; the value is not set", fn, value,
+                  bgm_var_names[vr]);
         return 0;
     }
     if (value < lo || value > hi) {
-        bgm_error(c, "%s: value %g for %s is outside its range [%g, %g]", fn, value,
-                  bgm_var_names[vr], lo, hi);
+        char los[32], his[32];
+        if (lo <= -DBL_MAX) snprintf(los, sizeof(los), "-inf");
+        else snprintf(los, sizeof(los), "%.17g", lo);
+        if (hi >= DBL_MAX) snprintf(his, sizeof(his), "inf");
+        else snprintf(his, sizeof(his), "%.17g", hi);
+        bgm_error(c, "%s: value %.17g for %s is outside its range [%s, %s] (min, max); "
+                  "the value is not set", fn, value, bgm_var_names[vr], los, his);
         return 0;
     }
     return 1;
@@ -556,6 +616,9 @@ bgm_status bgm_set_real(bgm_inst *c, const char *fn, const unsigned vr[], size_t
             if (i == 0) c->v.solver_tol = values[k];
             else c->v.solver_hmax = values[k];
             break;
+#if BGM_HYBRID
+        case BGM_VAR_DISCRETE: bgm_hyb_set(c, i, values[k]); break;
+#endif
         default: break;
         }
     }
@@ -768,9 +831,25 @@ bgm_status bgm_do_step(bgm_inst *c, const char *fn, double t, double h) {
                   c->v.time);
         return BGM_ERROR;
     }
+    if (c->stop_defined) {
+        /* the step may end at the stop time up to rounding (t_k = t0 + k h, importers
+           comparing with a relative tolerance of 1e-9), not beyond */
+        double end = t + h;
+        double slack = 1e-8 * (fabs(c->stop_time) > 1.0 ? fabs(c->stop_time) : 1.0);
+        if (end > c->stop_time + slack) {
+            bgm_error(c, "%s: the step from t=%.17g by %.17g ends at %.17g, past the stop "
+                      "time %.17g given at initialization (stopTimeDefined); the step is "
+                      "not taken", fn, t, h, end, c->stop_time);
+            return BGM_ERROR;
+        }
+    }
     c->v.time = t;
     c->cache_valid = 0;
+#if BGM_HYBRID
+    if (h > 0.0 && bgm_hyb_integrate(c, fn, t + h) != BGM_OK) {
+#else
     if (h > 0.0 && bgm_integrate(c, fn, t + h) != BGM_OK) {
+#endif
         c->cache_valid = 0;
         return BGM_ERROR;
     }

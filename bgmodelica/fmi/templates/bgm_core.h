@@ -19,6 +19,10 @@
 #define BGM_NPA (BGM_NP > 0 ? BGM_NP : 1)
 #define BGM_NYA (BGM_NY > 0 ? BGM_NY : 1)
 
+#if BGM_HYBRID
+#include "bgm_events.h"
+#endif
+
 /* value-reference layout (see bgmodelica/fmi/variables.py) */
 #define BGM_VR_TIME 0u
 #define BGM_VR_X 1u
@@ -27,7 +31,13 @@
 #define BGM_VR_P (BGM_VR_U + BGM_NU)
 #define BGM_VR_Y (BGM_VR_P + BGM_NP)
 #define BGM_VR_SOLVER (BGM_VR_Y + BGM_NY)
+#if BGM_HYBRID
+#define BGM_VR_D (BGM_VR_SOLVER + BGM_NSOLVER) /* exported discrete variables */
+#define BGM_VR_Z (BGM_VR_D + BGM_NDV)          /* event indicators (FMI 3.0 ME) */
+#define BGM_NVR (BGM_VR_Z + BGM_NZV)
+#else
 #define BGM_NVR (BGM_VR_SOLVER + BGM_NSOLVER)
+#endif
 
 typedef enum { BGM_OK = 0, BGM_WARNING = 1, BGM_DISCARD = 2, BGM_ERROR = 3, BGM_FATAL = 4 }
     bgm_status;
@@ -48,14 +58,15 @@ enum { BGM_KIND_ME = 1, BGM_KIND_CS = 2 };
 /* variable kinds returned by bgm_classify */
 enum {
     BGM_VAR_NONE = 0, BGM_VAR_TIME, BGM_VAR_STATE, BGM_VAR_DERIVATIVE, BGM_VAR_INPUT,
-    BGM_VAR_PARAMETER, BGM_VAR_OUTPUT, BGM_VAR_SOLVER
+    BGM_VAR_PARAMETER, BGM_VAR_OUTPUT, BGM_VAR_SOLVER, BGM_VAR_DISCRETE, BGM_VAR_INDICATOR
 };
 
 /* log categories */
 #define BGM_LOG_WARNING 1u
 #define BGM_LOG_ERROR 2u
 #define BGM_LOG_SOLVER 4u
-#define BGM_LOG_ALL 7u
+#define BGM_LOG_EVENTS 8u
+#define BGM_LOG_ALL 15u
 
 /* Everything that makes up the FMU state (copied verbatim by Get/SetFMUState). */
 typedef struct {
@@ -72,6 +83,9 @@ typedef struct {
     double solver_tol;     /* parameter solver.tolerance */
     double solver_hmax;    /* parameter solver.max_step */
     double h_next;         /* step-size proposal of the embedded solver (0: none) */
+#if BGM_HYBRID
+    bgm_hyb_vars h;        /* discrete slots and event state (bgm_events.c) */
+#endif
 } bgm_vars;
 
 struct bgm_inst;
@@ -106,11 +120,15 @@ typedef struct bgm_inst {
     double **res;
     casadi_int *iw;
     double *w;
-    int mem[5];
+    int mem[16];
     /* solver work memory */
     double *ws;
     int *piv;
     long stat_steps, stat_rejected, stat_newton_fail, stat_f, stat_jac;
+#if BGM_HYBRID
+    int early_return_allowed; /* FMI 3.0 Co-Simulation */
+    bgm_hyb_work hw;          /* scratch of the event functions */
+#endif
 } bgm_inst;
 
 /* model data (bgm_model_data.c, generated) */
@@ -189,5 +207,27 @@ bgm_status bgm_deserialize(bgm_inst *c, const char *fn, const void *bytes, size_
 int bgm_call_ode(bgm_inst *c, double t, const double *x, double *xdot, double *y);
 int bgm_call_xdot(bgm_inst *c, double t, const double *x, double *xdot);
 int bgm_call_jacx(bgm_inst *c, double t, const double *x, double *jac);
+
+#if BGM_HYBRID
+/* events (bgm_events.c); bgm_call_event: which = 0 evstep, 1 evind, 2 evsamp */
+int bgm_call_event(bgm_inst *c, int which, double t, const double *x, double **outs, int nouts);
+void bgm_hyb_defaults(bgm_inst *c);
+bgm_status bgm_hyb_initialize(bgm_inst *c, const char *fn);
+bgm_status bgm_hyb_enter_event(bgm_inst *c, const char *fn);
+bgm_status bgm_hyb_update(bgm_inst *c, const char *fn, int *need_update, int *x_changed,
+                          int *next_defined, double *next_time);
+bgm_status bgm_hyb_terminate(bgm_inst *c, const char *fn);
+bgm_status bgm_hyb_event_indicators(bgm_inst *c, const char *fn, double z[], size_t ni);
+bgm_status bgm_hyb_integrate(bgm_inst *c, const char *fn, double t_end);
+int bgm_hyb_step_check(bgm_inst *c, double t0, const double *x0, double t1, const double *x1);
+bgm_status bgm_hyb_value(bgm_inst *c, const char *fn, int kind, size_t i, int type,
+                         int *evaluated, double *value);
+int bgm_hyb_check_set(bgm_inst *c, const char *fn, size_t i, int type, double value);
+void bgm_hyb_set(bgm_inst *c, size_t i, double value);
+bgm_status bgm_hyb_get_typed(bgm_inst *c, const char *fn, const unsigned vr[], size_t n,
+                             int type, int bool_byte, void *values);
+bgm_status bgm_hyb_set_typed(bgm_inst *c, const char *fn, const unsigned vr[], size_t n,
+                             int type, int bool_byte, const void *values);
+#endif
 
 #endif

@@ -248,6 +248,10 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
         if (fac > 5.0) fac = 5.0;
         if (fac < 0.2) fac = 0.2;
         if (en <= 1.0) {
+#if BGM_HYBRID
+            /* a relation left its frozen value during this step: stop, the caller locates it */
+            int crossed = bgm_hyb_step_check(c, t, x0, clipped ? t_end : t + hs, Y);
+#endif
             c->stat_steps++;
             t = clipped ? t_end : t + hs;
             memcpy(x0, Y, n * sizeof(double));
@@ -263,6 +267,13 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
             /* commit the accepted step: DoStep failures later keep a consistent state */
             memcpy(c->v.x, x0, n * sizeof(double));
             c->v.time = t;
+#if BGM_HYBRID
+            if (crossed) {
+                c->v.h_next = h;
+                c->cache_valid = 0;
+                return BGM_OK;
+            }
+#endif
         } else {
             c->stat_rejected++;
             last_rejected = 1;

@@ -110,15 +110,23 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
 
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                           fmi2Integer value[]) {
-    (void)value;
     VALID_OR_ERROR(c);
+#if BGM_HYBRID
+    return (fmi2Status)bgm_hyb_get_typed(INST, "fmi2GetInteger", vr, nvr, BGM_DV_INTEGER, 0,
+                                         value);
+#endif
+    (void)value;
     return (fmi2Status)bgm_no_variables(INST, "fmi2GetInteger", "Integer", vr, nvr);
 }
 
 fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                           fmi2Boolean value[]) {
-    (void)value;
     VALID_OR_ERROR(c);
+#if BGM_HYBRID
+    return (fmi2Status)bgm_hyb_get_typed(INST, "fmi2GetBoolean", vr, nvr, BGM_DV_BOOLEAN, 0,
+                                         value);
+#endif
+    (void)value;
     return (fmi2Status)bgm_no_variables(INST, "fmi2GetBoolean", "Boolean", vr, nvr);
 }
 
@@ -137,15 +145,23 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
 
 fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                           const fmi2Integer value[]) {
-    (void)value;
     VALID_OR_ERROR(c);
+#if BGM_HYBRID
+    return (fmi2Status)bgm_hyb_set_typed(INST, "fmi2SetInteger", vr, nvr, BGM_DV_INTEGER, 0,
+                                         value);
+#endif
+    (void)value;
     return (fmi2Status)bgm_no_variables(INST, "fmi2SetInteger", "Integer", vr, nvr);
 }
 
 fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                           const fmi2Boolean value[]) {
-    (void)value;
     VALID_OR_ERROR(c);
+#if BGM_HYBRID
+    return (fmi2Status)bgm_hyb_set_typed(INST, "fmi2SetBoolean", vr, nvr, BGM_DV_BOOLEAN, 0,
+                                         value);
+#endif
+    (void)value;
     return (fmi2Status)bgm_no_variables(INST, "fmi2SetBoolean", "Boolean", vr, nvr);
 }
 

@@ -18,7 +18,11 @@ fmi2Status fmi2EnterEventMode(fmi2Component c) {
     ME_OR_ERROR(c, "fmi2EnterEventMode");
     if (!bgm_check(INST, "fmi2EnterEventMode", BGM_MODE_EVENT | BGM_MODE_CONT)) return fmi2Error;
     INST->v.mode = BGM_MODE_EVENT;
+#if BGM_HYBRID
+    return (fmi2Status)bgm_hyb_enter_event(INST, "fmi2EnterEventMode");
+#else
     return fmi2OK;
+#endif
 }
 
 fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *eventInfo) {
@@ -28,6 +32,22 @@ fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *eventInfo) {
         bgm_error(INST, "fmi2NewDiscreteStates: eventInfo is NULL");
         return fmi2Error;
     }
+#if BGM_HYBRID
+    {
+        int need, changed, defined;
+        double next;
+        if (bgm_hyb_update(INST, "fmi2NewDiscreteStates", &need, &changed, &defined, &next) !=
+            BGM_OK)
+            return fmi2Error;
+        eventInfo->newDiscreteStatesNeeded = need ? fmi2True : fmi2False;
+        eventInfo->terminateSimulation = fmi2False;
+        eventInfo->nominalsOfContinuousStatesChanged = fmi2False;
+        eventInfo->valuesOfContinuousStatesChanged = changed ? fmi2True : fmi2False;
+        eventInfo->nextEventTimeDefined = defined ? fmi2True : fmi2False;
+        eventInfo->nextEventTime = next;
+        return fmi2OK;
+    }
+#endif
     eventInfo->newDiscreteStatesNeeded = fmi2False;
     eventInfo->terminateSimulation = fmi2False;
     eventInfo->nominalsOfContinuousStatesChanged = fmi2False;
@@ -76,9 +96,14 @@ fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx
 }
 
 fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real eventIndicators[], size_t ni) {
-    (void)eventIndicators;
     ME_OR_ERROR(c, "fmi2GetEventIndicators");
+#if BGM_HYBRID
+    return (fmi2Status)bgm_hyb_event_indicators(INST, "fmi2GetEventIndicators", eventIndicators,
+                                                ni);
+#else
+    (void)eventIndicators;
     return (fmi2Status)bgm_event_indicators(INST, "fmi2GetEventIndicators", ni);
+#endif
 }
 
 fmi2Status fmi2GetContinuousStates(fmi2Component c, fmi2Real x[], size_t nx) {

@@ -87,13 +87,18 @@ fmi3Instance fmi3InstantiateCoSimulation(
     bgm_inst *inst;
     (void)resourcePath;
     (void)visible;
+#if !BGM_HYBRID
     (void)earlyReturnAllowed;
+#endif
     (void)requiredIntermediateVariables;
     (void)intermediateUpdate;
     inst = fmi3_new("fmi3InstantiateCoSimulation", BGM_KIND_CS, instanceName,
                     instantiationToken, loggingOn, instanceEnvironment, logMessage);
     if (inst) {
         inst->event_mode_used = eventModeUsed ? 1 : 0;
+#if BGM_HYBRID
+        inst->early_return_allowed = earlyReturnAllowed ? 1 : 0;
+#endif
         if (nRequiredIntermediateVariables > 0)
             bgm_log(inst, BGM_WARNING, "logStatusWarning",
                     "fmi3InstantiateCoSimulation: intermediate update is not provided, "
@@ -156,7 +161,11 @@ fmi3Status fmi3EnterEventMode(fmi3Instance instance) {
             return fmi3Error;
     }
     INST->v.mode = BGM_MODE_EVENT;
+#if BGM_HYBRID
+    return (fmi3Status)bgm_hyb_enter_event(INST, "fmi3EnterEventMode");
+#else
     return fmi3OK;
+#endif
 }
 
 fmi3Status fmi3Terminate(fmi3Instance instance) {
@@ -225,11 +234,59 @@ BGM_NO_VARS(Int8, fmi3Int8)
 BGM_NO_VARS(UInt8, fmi3UInt8)
 BGM_NO_VARS(Int16, fmi3Int16)
 BGM_NO_VARS(UInt16, fmi3UInt16)
+#if BGM_HYBRID
+fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                        size_t nValueReferences, fmi3Int32 values[], size_t nValues) {
+    VALID_OR_ERROR(instance);
+    if (nValues != nValueReferences) {
+        bgm_error(INST, "fmi3GetInt32: nValues must equal nValueReferences (scalars only)");
+        return fmi3Error;
+    }
+    return (fmi3Status)bgm_hyb_get_typed(INST, "fmi3GetInt32", valueReferences,
+                                         nValueReferences, BGM_DV_INTEGER, 0, values);
+}
+fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                        size_t nValueReferences, const fmi3Int32 values[], size_t nValues) {
+    VALID_OR_ERROR(instance);
+    if (nValues != nValueReferences) {
+        bgm_error(INST, "fmi3SetInt32: nValues must equal nValueReferences (scalars only)");
+        return fmi3Error;
+    }
+    return (fmi3Status)bgm_hyb_set_typed(INST, "fmi3SetInt32", valueReferences,
+                                         nValueReferences, BGM_DV_INTEGER, 0, values);
+}
+#else
 BGM_NO_VARS(Int32, fmi3Int32)
+#endif
 BGM_NO_VARS(UInt32, fmi3UInt32)
 BGM_NO_VARS(Int64, fmi3Int64)
 BGM_NO_VARS(UInt64, fmi3UInt64)
+#if BGM_HYBRID
+fmi3Status fmi3GetBoolean(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                          size_t nValueReferences, fmi3Boolean values[], size_t nValues) {
+    VALID_OR_ERROR(instance);
+    if (nValues != nValueReferences) {
+        bgm_error(INST, "fmi3GetBoolean: nValues must equal nValueReferences (scalars only)");
+        return fmi3Error;
+    }
+    return (fmi3Status)bgm_hyb_get_typed(INST, "fmi3GetBoolean", valueReferences,
+                                         nValueReferences, BGM_DV_BOOLEAN,
+                                         sizeof(fmi3Boolean) == 1, values);
+}
+fmi3Status fmi3SetBoolean(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                          size_t nValueReferences, const fmi3Boolean values[], size_t nValues) {
+    VALID_OR_ERROR(instance);
+    if (nValues != nValueReferences) {
+        bgm_error(INST, "fmi3SetBoolean: nValues must equal nValueReferences (scalars only)");
+        return fmi3Error;
+    }
+    return (fmi3Status)bgm_hyb_set_typed(INST, "fmi3SetBoolean", valueReferences,
+                                         nValueReferences, BGM_DV_BOOLEAN,
+                                         sizeof(fmi3Boolean) == 1, values);
+}
+#else
 BGM_NO_VARS(Boolean, fmi3Boolean)
+#endif
 BGM_NO_VARS(String, fmi3String)
 
 fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -382,6 +439,23 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discrete
                                     fmi3Float64 *nextEventTime) {
     VALID_OR_ERROR(instance);
     if (!bgm_check(INST, "fmi3UpdateDiscreteStates", BGM_MODE_EVENT)) return fmi3Error;
+#if BGM_HYBRID
+    {
+        int need, changed, defined;
+        double next;
+        if (bgm_hyb_update(INST, "fmi3UpdateDiscreteStates", &need, &changed, &defined,
+                           &next) != BGM_OK)
+            return fmi3Error;
+        if (discreteStatesNeedUpdate) *discreteStatesNeedUpdate = need ? fmi3True : fmi3False;
+        if (terminateSimulation) *terminateSimulation = fmi3False;
+        if (nominalsOfContinuousStatesChanged) *nominalsOfContinuousStatesChanged = fmi3False;
+        if (valuesOfContinuousStatesChanged)
+            *valuesOfContinuousStatesChanged = changed ? fmi3True : fmi3False;
+        if (nextEventTimeDefined) *nextEventTimeDefined = defined ? fmi3True : fmi3False;
+        if (nextEventTime) *nextEventTime = next;
+        return fmi3OK;
+    }
+#endif
     if (discreteStatesNeedUpdate) *discreteStatesNeedUpdate = fmi3False;
     if (terminateSimulation) *terminateSimulation = fmi3False;
     if (nominalsOfContinuousStatesChanged) *nominalsOfContinuousStatesChanged = fmi3False;

@@ -47,6 +47,13 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
     if (eventHandlingNeeded) *eventHandlingNeeded = fmi3False;
     if (terminateSimulation) *terminateSimulation = fmi3False;
     if (earlyReturn) *earlyReturn = fmi3False;
+#if BGM_HYBRID
+    if (s == BGM_OK && eventHandlingNeeded && INST->hw.event_needed)
+        *eventHandlingNeeded = fmi3True;
+    if (s == BGM_OK && earlyReturn &&
+        INST->v.time < currentCommunicationPoint + communicationStepSize)
+        *earlyReturn = fmi3True;
+#endif
     if (lastSuccessfulTime) *lastSuccessfulTime = INST->v.time;
     return (fmi3Status)s;
 }

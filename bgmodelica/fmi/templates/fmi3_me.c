@@ -56,9 +56,14 @@ fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 
 
 fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 eventIndicators[],
                                   size_t nEventIndicators) {
-    (void)eventIndicators;
     ME_OR_ERROR(instance, "fmi3GetEventIndicators");
+#if BGM_HYBRID
+    return (fmi3Status)bgm_hyb_event_indicators(INST, "fmi3GetEventIndicators", eventIndicators,
+                                                nEventIndicators);
+#else
+    (void)eventIndicators;
     return (fmi3Status)bgm_event_indicators(INST, "fmi3GetEventIndicators", nEventIndicators);
+#endif
 }
 
 fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 continuousStates[],
@@ -81,7 +86,11 @@ fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *nEventI
         bgm_error(INST, "fmi3GetNumberOfEventIndicators: NULL argument");
         return fmi3Error;
     }
+#if BGM_HYBRID
+    *nEventIndicators = BGM_NZ;
+#else
     *nEventIndicators = 0;
+#endif
     return fmi3OK;
 }
 

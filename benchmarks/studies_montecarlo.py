@@ -1,0 +1,148 @@
+"""Monte Carlo of the PID robot on Dask: throughput with local workers vs serial, per-run cost
+vs one plain ``simulate`` of the compiled model, and what shipping the model to a worker costs.
+
+200 runs of ``library.robots:RobotPID`` over 10 s (output every 10 ms), link masses m1, m2 and
+motor resistances motor1.R, motor2.R uniform within +-5 % of their values, seed 1.
+
+    .venv/bin/python benchmarks/studies_montecarlo.py [--runs 200] [--workers 2] [--plot PNG]
+
+Prints (in the same run, same machine):
+
+* compile time, pickled model size, unpickle time vs compile time (the worker-side cost of
+  receiving the model, once per worker);
+* one plain ``simulate(compiled, 10 s)`` (median of 5, default parameters) and a plain loop
+  of ``simulate`` over the study's 200 parameter sets (the fair per-run reference: IDAS needs
+  up to 10x more steps for some parameter sets of this model, whose PID output saturates);
+* the study serially in this process (``scheduler="serial"``) and on a LocalCluster of
+  ``--workers`` processes (cluster start-up reported separately): wall time, runs/s, speed-up
+  (aim >= 1.6x with 2 workers on 2 cores) and per-run cost / plain simulate (aim <= 1.2x).
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import statistics
+import sys
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
+
+OUTPUTS = ["arm.joint1.q", "arm.joint2.q", "e1", "e2", "motor1.inductor.i",
+           "motor2.inductor.i"]
+SPREAD = {"m1": "+-5%", "m2": "+-5%", "motor1.R": "+-5%", "motor2.R": "+-5%"}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--runs", type=int, default=200)
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--stop-time", type=float, default=10.0)
+    ap.add_argument("--solver", default="cvodes", help="cvodes (default) or idas")
+    ap.add_argument("--plot", default=None,
+                    help="band plot of the joint-1 tracking error e1 (PNG)")
+    args = ap.parse_args()
+
+    import bgmodelica as bg
+    from bgmodelica.loader import load_model
+    from bgmodelica.studies import sweep
+    from bgmodelica.studies.payload import pickle_compiled, unpickle_compiled
+
+    print(f"load average at start: {os.getloadavg()[0]:.2f} ({os.cpu_count()} cores)")
+    t = time.perf_counter()
+    compiled = bg.compile(load_model("library.robots:RobotPID"))
+    t_compile = time.perf_counter() - t
+    blob = pickle_compiled(compiled)
+    t = time.perf_counter()
+    unpickle_compiled(blob)
+    t_unpickle = time.perf_counter() - t
+    print(f"compile {t_compile:.3f} s; pickled compiled model {len(blob) / 1e3:.0f} kB, "
+          f"unpickled in {t_unpickle * 1e3:.1f} ms (what a worker pays once instead of "
+          "compiling)")
+
+    kw = dict(stop_time=args.stop_time, interval=0.01, outputs=OUTPUTS, solver=args.solver)
+    bg.simulate(compiled, **kw)                                   # warm: integrators built
+    plain, plain_cpu = [], []
+    for _ in range(5):
+        t, c = time.perf_counter(), time.process_time()
+        bg.simulate(compiled, **kw)
+        plain.append(time.perf_counter() - t)
+        plain_cpu.append(time.process_time() - c)
+    t_plain, c_plain = statistics.median(plain), statistics.median(plain_cpu)
+    print(f"plain simulate of the compiled model, {args.stop_time:g} s ({args.solver}): "
+          f"{t_plain * 1e3:.1f} ms wall, {c_plain * 1e3:.1f} ms CPU (median of 5)")
+
+    study = dict(samples=args.runs, distributions=SPREAD, seed=1, progress=False, **kw)
+    c = time.process_time()
+    serial = sweep(compiled, scheduler="serial", **study)
+    c_serial = (time.process_time() - c) / args.runs
+    w_serial = serial.meta["wall_seconds"]
+    names = serial.parameters
+    draws = [{n: float(serial[n].values[k]) for n in names} for k in range(args.runs)]
+    t, c = time.perf_counter(), time.process_time()
+    for d in draws:                              # the same runs as plain simulate calls
+        bg.simulate(compiled, params=d, **kw)
+    t_loop = (time.perf_counter() - t) / args.runs
+    c_loop = (time.process_time() - c) / args.runs
+    print(f"plain simulate loop over the same {args.runs} parameter sets: "
+          f"{t_loop * 1e3:.1f} ms wall, {c_loop * 1e3:.1f} ms CPU per run "
+          f"({c_loop / c_plain:.2f}x the default-parameter run: the solver's work varies)")
+    print(f"serial study: {args.runs} runs in {w_serial:.2f} s = {args.runs / w_serial:.1f} "
+          f"runs/s; CPU per run {c_serial * 1e3:.1f} ms = {c_serial / c_plain:.2f}x one plain "
+          f"simulate, {c_serial / c_loop:.2f}x the plain loop ({serial.meta['n_failed']} "
+          "failed)")
+
+    from distributed import Client, LocalCluster
+
+    t = time.perf_counter()
+    cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
+                           dashboard_address=None, silence_logs=logging.ERROR,
+                           preload=["bgmodelica.studies.worker"])
+    client = Client(cluster)
+    t_start = time.perf_counter() - t
+
+    def worker_cpu() -> float:
+        import psutil
+
+        def cpu() -> float:
+            ct = psutil.Process().cpu_times()
+            return ct.user + ct.system
+
+        return sum(client.run(cpu).values())
+
+    try:
+        results = []
+        for _label in ("first study", "second study (warm)"):
+            c0 = worker_cpu()
+            res = sweep(compiled, client=client, **study)
+            results.append((res, (worker_cpu() - c0) / args.runs))
+        from bgmodelica.studies import payload as payload_mod
+
+        stats = client.run(lambda: dict(payload_mod.STATS))
+    finally:
+        client.close()
+        cluster.close()
+    dist = results[0][0]
+    same = float(abs(dist["arm.joint1.q"].values - serial["arm.joint1.q"].values).max())
+    used = sorted(set(dist["worker"].values))
+    print(f"LocalCluster of {args.workers} workers started in {t_start:.2f} s; model on the "
+          "workers: " + "; ".join(f"{how['how']} in {how['seconds'] * 1e3:.1f} ms"
+                                  for w in stats.values() for how in w.values()))
+    for label, (res, cpu) in zip(("first study", "second study (warm)"), results,
+                                 strict=True):
+        wall = res.meta["wall_seconds"]
+        print(f"{args.workers} workers, {label}: {args.runs} runs in {wall:.2f} s = "
+              f"{args.runs / wall:.1f} runs/s, speed-up vs serial {w_serial / wall:.2f}x; "
+              f"worker CPU per run (runs + Dask) {cpu * 1e3:.1f} ms = {cpu / c_plain:.2f}x one "
+              f"plain simulate, {cpu / c_loop:.2f}x the plain loop")
+    print(f"runs spread over {len(used)} worker processes; max |serial - distributed| of "
+          f"joint 1 = {same:.1e} rad")
+    print(f"load average at the end: {os.getloadavg()[0]:.2f}")
+    if args.plot:
+        dist.plot_band("e1", args.plot, show_runs=0)
+        print(f"band plot -> {args.plot}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,191 @@
+"""Results in the Python data ecosystem: pandas, xarray and CSV, with units, both ways.
+
+Used through :class:`~bgmodelica.result.Result`: ``result.to_pandas()``,
+``result.to_xarray()``, ``result.to_csv(path, units=True)`` and
+``Result.from_pandas(df)``, ``Result.from_xarray(ds)``, ``Result.read_csv(path)``.
+
+**Events.** A run with events holds two rows at each event instant, the left limit then the
+right limit, with the *same* time. Both rows are kept: the time index of the DataFrame (and
+the ``time`` coordinate of the Dataset) is then *not unique* -- select by position
+(``df.iloc``) or with a boolean mask (``df[df.index >= 1.0]``); ``df.loc[t]`` returns both
+rows at an event instant. ``attrs["event_times"]`` lists the instants.
+
+**Units** of every column are in ``df.attrs["units"]`` (name -> unit string, ``"time"`` ->
+``"s"``) and in each data variable's ``attrs["units"]`` of the Dataset (the CF convention);
+parameters go to ``df.attrs["parameters"]`` and to 0-d data variables of the Dataset
+(``attrs["kind"] = "parameter"``).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .result import Result
+
+#: first cell of the optional units row of a CSV file
+UNITS_ROW = "s"
+
+
+def unit_of(result: Result, name: str) -> str:
+    """The unit of ``name`` in ``result`` ("" if unknown): declared, through an alias, or
+    ``s`` for time."""
+    if name in ("time", "t"):
+        return "s"
+    if name in result.units:
+        return result.units[name] or ""
+    if name in result.aliases:
+        return unit_of(result, result.aliases[name][0])
+    return ""
+
+
+def _names(result: Result, names: Sequence[str] | None) -> list[str]:
+    return list(names) if names is not None else result.all_names()
+
+
+def _meta_attrs(result: Result) -> dict[str, Any]:
+    attrs: dict[str, Any] = {}
+    events = result.meta.get("event_times")
+    if events is not None:
+        attrs["event_times"] = [float(t) for t in events]
+    if "model" in result.meta:
+        attrs["model"] = str(result.meta["model"])
+    return attrs
+
+
+def to_pandas(result: Result, names: Sequence[str] | None = None) -> Any:
+    """A :class:`pandas.DataFrame`: index ``time`` [s] (not unique at events), one column
+    per dotted name (default: every variable and alias), units in ``df.attrs["units"]``,
+    parameters in ``df.attrs["parameters"]``, event instants in ``df.attrs["event_times"]``.
+    """
+    import pandas as pd
+
+    cols = _names(result, names)
+    data = {n: np.asarray(result[n], dtype=float) for n in cols}
+    df = pd.DataFrame(data, index=pd.Index(np.asarray(result.time, dtype=float), name="time"),
+                      columns=cols)
+    df.attrs["units"] = {"time": "s", **{n: unit_of(result, n) for n in cols}}
+    df.attrs["parameters"] = dict(result.parameters)
+    df.attrs["parameter_units"] = {n: result.units.get(n, "") for n in result.parameters}
+    df.attrs.update(_meta_attrs(result))
+    return df
+
+
+def to_xarray(result: Result, names: Sequence[str] | None = None,
+              parameters: bool = True) -> Any:
+    """An :class:`xarray.Dataset` with the coordinate ``time`` [s] (not unique at events),
+    one data variable per dotted name with ``attrs["units"]``, and (``parameters``) every
+    parameter as a 0-d data variable with ``attrs["kind"] = "parameter"``."""
+    import xarray as xr
+
+    cols = _names(result, names)
+    time = xr.DataArray(np.asarray(result.time, dtype=float), dims="time",
+                        attrs={"units": "s", "long_name": "time"})
+    data = {n: xr.DataArray(np.asarray(result[n], dtype=float), dims="time",
+                            attrs={"units": unit_of(result, n), "long_name": n})
+            for n in cols}
+    if parameters:
+        for n, v in result.parameters.items():
+            if n not in data:
+                data[n] = xr.DataArray(float(v), attrs={"units": result.units.get(n, ""),
+                                                        "long_name": n, "kind": "parameter"})
+    attrs = _meta_attrs(result)
+    return xr.Dataset(data, coords={"time": time}, attrs=attrs)
+
+
+def _result(time: np.ndarray, columns: dict[str, np.ndarray], units: dict[str, str],
+            parameters: dict[str, float], attrs: dict[str, Any]) -> Result:
+    from .result import Result
+
+    names = list(columns)
+    values = (np.column_stack([columns[n] for n in names]) if names
+              else np.zeros((len(time), 0)))
+    meta: dict[str, Any] = {}
+    if "event_times" in attrs:
+        meta["event_times"] = [float(t) for t in np.atleast_1d(attrs["event_times"])]
+        meta["n_events"] = len(meta["event_times"])
+    if "model" in attrs:
+        meta["model"] = attrs["model"]
+    unit_map = {n: u for n, u in units.items() if n not in ("time", "t")}
+    return Result(np.asarray(time, dtype=float), values, names, {}, dict(parameters),
+                  unit_map, meta)
+
+
+def from_pandas(df: Any) -> Result:
+    """The inverse of :func:`to_pandas` (any DataFrame with a numeric time index or a
+    ``time`` column works; units are read from ``df.attrs["units"]`` when present)."""
+    if "time" in df.columns:
+        df = df.set_index("time")
+    units = dict(df.attrs.get("units", {}))
+    units.update(df.attrs.get("parameter_units", {}))
+    cols = {str(c): df[c].to_numpy(dtype=float) for c in df.columns}
+    return _result(df.index.to_numpy(dtype=float), cols, units,
+                   {k: float(v) for k, v in df.attrs.get("parameters", {}).items()},
+                   df.attrs)
+
+
+def from_xarray(ds: Any) -> Result:
+    """The inverse of :func:`to_xarray`: 1-d variables along ``time`` are trajectories, 0-d
+    variables parameters; units from each variable's ``attrs["units"]``."""
+    cols: dict[str, np.ndarray] = {}
+    params: dict[str, float] = {}
+    units: dict[str, str] = {}
+    for name, var in ds.data_vars.items():
+        units[str(name)] = str(var.attrs.get("units", ""))
+        if var.ndim == 0:
+            params[str(name)] = float(var.values)
+        elif var.dims == ("time",):
+            cols[str(name)] = np.asarray(var.values, dtype=float)
+    return _result(np.asarray(ds["time"].values, dtype=float), cols, units, params,
+                   dict(ds.attrs))
+
+
+def write_csv(result: Result, path: str | Path, names: Sequence[str] | None = None,
+              units: bool = False, fmt: str = "%.12g") -> Path:
+    """``time,<names>`` per row; with ``units`` a second header row holds the units
+    (``s,V,A,...``; an empty cell for a dimensionless or undeclared one)."""
+    cols = _names(result, names)
+    table = np.column_stack([np.asarray(result.time, dtype=float)]
+                            + [np.asarray(result[n], dtype=float) for n in cols])
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with path.open("w", newline="") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(["time", *cols])
+        if units:
+            writer.writerow([UNITS_ROW, *[unit_of(result, n) for n in cols]])
+        writer.writerows(np.char.mod(fmt, table).tolist())
+    return path
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def read_csv(path: str | Path) -> Result:
+    """Read a CSV written by :func:`write_csv` (or any CSV whose first column is the time):
+    the optional units row is recognised by its non-numeric cells."""
+    with Path(path).open(newline="") as fh:
+        rows = list(csv.reader(fh))
+    if not rows:
+        raise ValueError(f"{path}: empty CSV file")
+    header = [h.strip() for h in rows[0]]
+    body = rows[1:]
+    units: dict[str, str] = {}
+    if body and body[0] and not _is_number(body[0][0]):   # the units row: "s", ...
+        units = {n: u.strip() for n, u in zip(header, body[0], strict=False)}
+        body = body[1:]
+    table = np.array([[float(c) if c.strip() else math.nan for c in r] for r in body
+                      if r], dtype=float).reshape(-1, len(header))
+    cols = {n: table[:, k] for k, n in enumerate(header[1:], start=1)}
+    return _result(table[:, 0], cols, units, {}, {})

@@ -1,0 +1,288 @@
+"""Diagnosis of non-finite values (NaN, Inf) at a point of a simulation: which variable became
+non-finite first, through which operation (division by zero, log or sqrt of a negative
+number...) of which equation, with the values that caused it.
+
+Used at the initial point (before the integrator sees a NaN and fails with a generic message)
+and on results (the first time and variable that is not finite).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from .core.variables import TIME
+from .errors import InitializationError, SimulationError
+
+_HINTS = {
+    "OP_DIV": "division by zero", "OP_INV": "division by zero",
+    "OP_LOG": "log of a number <= 0", "OP_LOG1P": "log1p of a number <= -1",
+    "OP_SQRT": "square root of a negative number",
+    "OP_POW": "power of a negative number or of zero", "OP_CONSTPOW": "power of a negative "
+    "number or of zero", "OP_ASIN": "asin outside [-1, 1]", "OP_ACOS": "acos outside [-1, 1]",
+    "OP_ATANH": "atanh outside (-1, 1)", "OP_ACOSH": "acosh below 1", "OP_TAN": "tan at a pole",
+    "OP_EXP": "exp overflow", "OP_SINH": "sinh overflow", "OP_COSH": "cosh overflow",
+    "OP_MUL": "0 * inf or overflow", "OP_ADD": "inf - inf or overflow",
+    "OP_SUB": "inf - inf or overflow", "OP_FMOD": "fmod by zero",
+}
+_OPS = {getattr(ca, k): v for k, v in _HINTS.items() if hasattr(ca, k)}
+
+
+def _kind(v: float) -> str:
+    return "NaN" if math.isnan(v) else ("+Inf" if v > 0 else "-Inf")
+
+
+class _Point:
+    """Values of every symbol of a sorted model at one point, and evaluation of expressions."""
+
+    def __init__(self, dae: Any, values: dict[str, float], p: np.ndarray, t: float) -> None:
+        from .validate import _bound_values
+
+        srt = dae.sorted
+        self.model = srt.model
+        self.names = self.model.names()
+        syms: list[ca.SX] = []
+        vals: list[float] = []
+        for v in self.model.variables:
+            syms.append(v.sx)
+            vals.append(float(values.get(v.name, math.nan)))
+        p = np.asarray(p, dtype=float)
+        base = list(dae.parameters) + list(dae.inputs) + list(getattr(dae, "discretes", ()))
+        for q, val in zip(base, p, strict=False):
+            syms.append(q.sx)
+            vals.append(float(val))
+        bound = [q for q in self.model.parameters if isinstance(q.decl.value, ca.SX)]
+        if bound:
+            for q, val in zip(bound, _bound_values(dae, bound, p), strict=True):
+                syms.append(q.sx)
+                vals.append(math.nan if val is None else val)
+                self.names[q.sx.element_hash()] = q.name
+        syms.append(TIME.sx)
+        vals.append(float(t))
+        self.names[TIME.sx.element_hash()] = "time"
+        self.syms = syms
+        self.X = ca.vertcat(*syms)
+        self.vals = np.asarray(vals, dtype=float)
+        self.value_of = {s.element_hash(): v for s, v in zip(syms, vals, strict=True)}
+        self.t = float(t)
+
+    def eval(self, exprs: list[ca.SX]) -> np.ndarray:
+        if not exprs:
+            return np.zeros(0)
+        f = ca.Function("bgm_diag", [self.X], [ca.vertcat(*exprs)], {"allow_free": True}) \
+            if _ALLOW_FREE else ca.Function("bgm_diag", [self.X], [ca.vertcat(*exprs)])
+        with np.errstate(all="ignore"):
+            return np.asarray(f(self.vals), dtype=float).ravel()
+
+    def text(self, e: ca.SX, width: int = 90) -> str:
+        syms = [s for s in ca.symvar(e) if s.element_hash() in self.names]
+        if syms:
+            e = ca.substitute(e, ca.vertcat(*syms),
+                              ca.vertcat(*[ca.SX.sym(self.names[s.element_hash()])
+                                           for s in syms]))
+        out = str(e)
+        return out if len(out) <= width else out[: width - 3] + "..."
+
+    def leaves(self, e: ca.SX, limit: int = 6) -> str:
+        parts = []
+        for s in ca.symvar(e)[:limit]:
+            h = s.element_hash()
+            if h in self.value_of and h in self.names:
+                parts.append(f"{self.names[h]} = {self.value_of[h]:g}")
+        return ", ".join(parts)
+
+
+def _allow_free() -> bool:
+    try:
+        x = ca.SX.sym("x")
+        ca.Function("f", [x], [x], {"allow_free": True})
+        return True
+    except RuntimeError:
+        return False
+
+
+_ALLOW_FREE = _allow_free()
+
+
+def _nodes(e: ca.SX, limit: int = 400) -> list[ca.SX]:
+    """Operation nodes of ``e`` in post order (children first), unique, at most ``limit``."""
+    out: list[ca.SX] = []
+    seen: set[int] = set()
+    stack: list[tuple[ca.SX, bool]] = [(e, False)]
+    while stack and len(out) < limit:
+        node, done = stack.pop()
+        h = node.element_hash()
+        if node.is_leaf() or (h in seen and not done):
+            continue
+        if done:
+            if h not in seen:
+                seen.add(h)
+                out.append(node)
+            continue
+        stack.append((node, True))
+        stack.extend((node.dep(i), False) for i in range(node.n_dep()))
+    return out
+
+
+def _operation(pt: _Point, e: ca.SX) -> str:
+    """The first operation of ``e`` giving a non-finite value from finite operands."""
+    nodes = _nodes(e)
+    if not nodes:
+        return ""
+    vals = pt.eval(nodes)
+    index = {n.element_hash(): k for k, n in enumerate(nodes)}
+
+    def value(x: ca.SX) -> float:
+        if x.is_constant():
+            return float(ca.DM(x))
+        h = x.element_hash()
+        if h in index:
+            return float(vals[index[h]])
+        return float(pt.value_of.get(h, math.nan))
+
+    for k, node in enumerate(nodes):
+        if math.isfinite(vals[k]):
+            continue
+        deps = [node.dep(i) for i in range(node.n_dep())]
+        if all(math.isfinite(value(d)) for d in deps):
+            hint = next((h for op, h in _OPS.items() if node.is_op(op)), "")
+            what = pt.text(node, 60)
+            where = pt.leaves(node)
+            return (f"{hint}: " if hint else "") + f"{what} = {_kind(vals[k])}" \
+                + (f" with {where}" if where else "")
+    return ""
+
+
+def explain(dae: Any, values: dict[str, float], p: np.ndarray, t: float) -> str:
+    """Why some variable is not finite at time ``t`` given the values of every variable:
+    the first variable (in evaluation order) computed from finite values that is not
+    finite, its operation and its equation; "" when it cannot be told."""
+    if getattr(dae, "sorted", None) is None:
+        return ""
+    pt = _Point(dae, values, p, t)
+    srt = dae.sorted
+    model = pt.model
+    variables = model.variables
+    eq_vars = srt.reduced.graph.eq_vars
+    finite = [math.isfinite(v) for v in pt.vals[:len(variables)]]
+    # 1) an equation undefined although every variable in it is finite
+    residuals = pt.eval([e.residual for e in model.equations])
+    for k, r in enumerate(residuals):
+        if not math.isfinite(r) and all(finite[j] for j in eq_vars[k] if j < len(finite)):
+            op = _operation(pt, model.equations[k].residual)
+            return (f"equation {model.describe(k)} is {_kind(r)} at t = {pt.t:g} s"
+                    + (f" ({op})" if op else ""))
+    # 2) the first assignment computing a non-finite value from finite ones
+    exprs = [d for _, d in srt.assignments]
+    got = pt.eval(exprs)
+    for (j, expr), val in zip(srt.assignments, got, strict=True):
+        if math.isfinite(val):
+            continue
+        ins = [s.element_hash() for s in ca.symvar(expr)]
+        if not all(math.isfinite(pt.value_of.get(h, math.nan)) for h in ins):
+            continue
+        name = variables[j].name
+        op = _operation(pt, expr)
+        eq = next((k for k, row in enumerate(eq_vars) if j in row
+                   and all(finite[i] for i in row if i != j and i < len(finite))), None)
+        return (f"{name} = {pt.text(expr)} is {_kind(val)} at t = {pt.t:g} s"
+                + (f" ({op})" if op else "")
+                + (f", from the equation {model.describe(eq)}" if eq is not None else ""))
+    return ""
+
+
+# -- checks --------------------------------------------------------------------------------------
+
+def _point_function(dae: Any) -> ca.Function:
+    key = ("bgm_point", dae.x.numel(), dae.z.numel(), dae.p.numel())
+    f = dae.cache.get(key)
+    if f is None:
+        f = ca.Function("bgm_point", [dae.t, dae.x, dae.z, dae.p],
+                        [dae.ode, dae.alg, dae.observed])
+        dae.cache[key] = f
+    return f
+
+
+def check_initial_point(dae: Any, x0: Any, z0: Any, p: Any, t0: float) -> None:
+    """Raise :class:`InitializationError` naming the equation and variable when the model is
+    undefined (NaN/Inf) at its initial point (``x0``, ``z0``)."""
+    f = _point_function(dae)
+    x0 = np.asarray(x0, dtype=float).reshape(-1)
+    z0 = np.asarray(z0, dtype=float).reshape(-1)
+    with np.errstate(all="ignore"):
+        ode, alg, obs = (np.asarray(v, dtype=float).ravel()
+                         for v in f(t0, x0 if dae.x.numel() else np.zeros(0),
+                                    z0 if dae.z.numel() else np.zeros(0), p))
+    if np.all(np.isfinite(ode)) and np.all(np.isfinite(alg)) and np.all(np.isfinite(obs)):
+        return
+    n_var = getattr(dae, "n_variables", 0) or len(dae.names)
+    values = {n: float(v) for n, v in zip(dae.names[:n_var], obs, strict=False)}
+    why = explain(dae, values, p, t0)
+    if not why:
+        bad = [dae.names[k] for k in np.flatnonzero(~np.isfinite(obs))][:5] \
+            or [f"der({dae.state_names[k]})" for k in np.flatnonzero(~np.isfinite(ode))][:5] \
+            or [f"residual of {dae.algebraic_names[k]}"
+                for k in np.flatnonzero(~np.isfinite(alg)) if k < len(dae.algebraic_names)][:5]
+        why = f"{', '.join(bad) or 'the model'} not finite at t = {t0:g} s"
+    raise InitializationError(f"the model is undefined at the initial point: {why}; check the "
+                              "parameter and start values")
+
+
+def check_result(result: Any, dae: Any, p: Any) -> None:
+    """Raise :class:`SimulationError` naming the first variable and time at which ``result``
+    is not finite; the error's ``result`` keeps the rows before that time."""
+    vals = result.values
+    if vals.size == 0:
+        return
+    with np.errstate(all="ignore"):
+        ok = np.isfinite(vals)
+    if ok.all():
+        return
+    row = int(np.argmax(~ok.all(axis=1)))
+    cols = np.flatnonzero(~ok[row])
+    names = [result.names[c] for c in cols]
+    t_bad = float(result.time[row])
+    first = f"{names[0]} is {_kind(float(vals[row, cols[0]]))} at t = {t_bad:g} s"
+    if len(names) > 1:
+        first += f" (also {', '.join(names[1:4])}{', ...' if len(names) > 4 else ''})"
+    why = ""
+    try:
+        values = {n: float(v) for n, v in zip(result.names, vals[row], strict=True)}
+        why = explain(dae, values, p, t_bad)
+    except Exception:       # a diagnosis must not hide the error itself  # noqa: BLE001
+        why = ""
+    from dataclasses import replace
+
+    kept = replace(result, time=result.time[:row], data=vals[:row])
+    t_ok = float(result.time[row - 1]) if row else float(result.time[0])
+    raise SimulationError(
+        f"{first}" + (f": {why}" if why else "")
+        + (f". The result is kept up to t = {t_ok:g} s (last finite point)" if row else
+           "; check the parameter and start values"), t_ok, kept)
+
+
+def singular_linear_block(residuals: list, unknowns: list, tries: int = 2) -> bool:
+    """Whether the block ``residuals = 0``, linear in ``unknowns``, is singular for every
+    value of the other symbols (its Jacobian is rank-deficient at random points): equations
+    that structural analysis matched but that are linearly dependent (ideal sources in a
+    loop or a cut, a state fixed by a constraint that index reduction could not see)."""
+    if not unknowns:
+        return False
+    r, v = ca.vertcat(*residuals), ca.vertcat(*unknowns)
+    a = ca.jacobian(r, v)
+    n = v.numel()
+    syms = ca.symvar(a)
+    if not syms:
+        m = np.asarray(ca.DM(ca.evalf(a)), dtype=float)
+        return bool(np.all(np.isfinite(m)) and np.linalg.matrix_rank(m) < n)
+    f = ca.Function("bgm_jac", [ca.vertcat(*syms)], [a])
+    rng = np.random.default_rng(2024)
+    for _ in range(tries):
+        with np.errstate(all="ignore"):
+            m = np.asarray(f(rng.uniform(0.5, 1.5, len(syms))), dtype=float)
+        if not np.all(np.isfinite(m)) or np.linalg.matrix_rank(m) == n:
+            return False
+    return True

@@ -1,0 +1,569 @@
+"""Checks of user input before any work is done: simulation options, the output grid, output
+files and plot variables, ``--arg`` values, parameter and start values against their declared
+``min``/``max``, and the wrapping of exceptions raised by user code.
+
+Every check raises a :class:`~bgmodelica.errors.ModelError` subclass whose message names the
+option, file, parameter or variable at fault; :func:`one_line` turns any message into the single
+line the command line prints.
+"""
+
+from __future__ import annotations
+
+import inspect
+import json
+import math
+import os
+import sysconfig
+import tempfile
+import traceback
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .errors import OptionError, ParameterError, UserCodeError
+
+#: output grids with more points than this are refused whatever the memory
+MAX_OUTPUT_POINTS = 50_000_000
+#: CLI spelling of the options of :func:`bgmodelica.simulate`
+_FLAGS = {"stop_time": "--stop-time", "interval": "--interval", "rtol": "--rtol",
+          "atol": "--atol", "start_time": "start_time", "max_step": "max_step",
+          "max_steps": "max_steps"}
+
+
+# -- messages ----------------------------------------------------------------------------------
+
+def one_line(message: str, limit: int = 2000) -> str:
+    """``message`` on one line: list items (indented lines) are joined with ", " after their
+    header, other lines with "; "."""
+    out = ""
+    in_list = False
+    for raw in str(message).splitlines():
+        line = raw.strip()
+        if not line:
+            continue
+        item = raw[:1].isspace()
+        if not out:
+            out = line
+        elif item and in_list:
+            out += ", " + line
+        else:
+            sep = " " if out.endswith((":", ".")) else ("; " if not item else ": ")
+            out += sep + line
+            in_list = item
+    if len(out) > limit:
+        out = out[: limit - 3] + "..."
+    return out
+
+
+def _option(name: str) -> str:
+    flag = _FLAGS.get(name, name)
+    return f"{name} ({flag})" if flag != name else name
+
+
+# -- simulation options --------------------------------------------------------------------------
+
+def _real(name: str, value: Any, *, allow_none: bool = False) -> float | None:
+    if value is None and allow_none:
+        return None
+    if isinstance(value, bool) or value is None:
+        raise OptionError(f"{_option(name)} must be a number, got {value!r}")
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        raise OptionError(f"{_option(name)} must be a number, got {value!r}") from None
+    if not math.isfinite(out):
+        raise OptionError(f"{_option(name)} is {value!r}: it must be a finite number")
+    return out
+
+
+def check_run_options(*, start_time: Any = 0.0, stop_time: Any = 1.0, interval: Any = None,
+                      rtol: Any = 1e-6, atol: Any = 1e-8, max_step: Any = None,
+                      max_steps: Any = 100000, solver: Any = "idas") -> dict[str, Any]:
+    """Validate the options of :func:`bgmodelica.simulate`; returns them as floats/ints.
+
+    Raises :class:`OptionError` naming the option: NaN, Inf, non-numbers, a stop time not
+    after the start time, a zero or negative interval, tolerances or step limits <= 0.
+    """
+    t0 = _real("start_time", start_time)
+    t1 = _real("stop_time", stop_time)
+    if t1 <= t0:
+        raise OptionError(f"{_option('stop_time')} = {t1:g} must be after the start time "
+                          f"{t0:g} s")
+    if not math.isfinite(t1 - t0):
+        raise OptionError(f"{_option('stop_time')} = {t1:g}: the simulated span overflows")
+    h = _real("interval", interval, allow_none=True)
+    if h is not None and h <= 0:
+        raise OptionError(f"{_option('interval')} = {h:g} must be positive (the output step "
+                          "in seconds)")
+    r = _real("rtol", rtol)
+    if not 0 < r < 1:
+        raise OptionError(f"{_option('rtol')} = {r:g} must be in (0, 1)")
+    a = _real("atol", atol)
+    if a <= 0:
+        raise OptionError(f"{_option('atol')} = {a:g} must be positive")
+    ms = _real("max_step", max_step, allow_none=True)
+    if ms is not None and ms <= 0:
+        raise OptionError(f"max_step = {ms:g} must be positive")
+    if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)) \
+            or max_steps < 1:
+        raise OptionError(f"max_steps must be a positive integer, got {max_steps!r}")
+    if solver not in ("idas", "cvodes"):
+        raise OptionError(f"solver must be 'idas' or 'cvodes', got {solver!r}")
+    return {"start_time": t0, "stop_time": t1, "interval": h, "rtol": r, "atol": a,
+            "max_step": ms, "max_steps": int(max_steps)}
+
+
+def _memory_bytes() -> int:
+    try:
+        return int(os.sysconf("SC_AVPHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):
+        return 8 << 30
+
+
+def _size(n: float) -> str:
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
+        if n < 1024 or unit == "PiB":
+            return f"{n:.1f} {unit}"
+        n /= 1024
+    return f"{n:.1f} PiB"
+
+
+def output_grid(start_time: float, stop_time: float, interval: float | None,
+                n_columns: int = 1, default_intervals: int = 500) -> np.ndarray:
+    """The output times: ``start, start + h, start + 2h, ...`` below ``stop`` and then
+    ``stop`` itself (``h`` = ``interval``; 500 equal intervals when None).
+
+    A point within 1e-9 h of ``stop`` is ``stop``. Grids that would not fit in memory (with
+    ``n_columns`` recorded values per point) are refused with their number of points.
+    """
+    span = stop_time - start_time
+    if interval is None:
+        return _increasing(np.linspace(start_time, stop_time, default_intervals + 1), None)
+    q = span / interval
+    n_full = math.floor(q + 1e-9) if math.isfinite(q) else math.inf
+    n_points = n_full + 1 + (0 if n_full != math.inf and abs(q - n_full) <= 1e-9 else 1)
+    need = n_points * (max(1, n_columns) + 1) * 8.0 * 2      # values + work arrays
+    if n_points > MAX_OUTPUT_POINTS or need > 0.5 * _memory_bytes():
+        count = f"{n_points:.0f}" if math.isfinite(n_points) else "infinitely many"
+        raise OptionError(
+            f"the output grid from {start_time:g} to {stop_time:g} s every {interval:g} s has "
+            f"{count} points ({n_columns} values each, about {_size(need)}): too many to "
+            f"hold (limit {MAX_OUTPUT_POINTS} points, {_size(0.5 * _memory_bytes())}); "
+            "raise the interval (--interval) or shorten the run")
+    grid = start_time + np.arange(n_full + 1, dtype=float) * interval
+    if stop_time - grid[-1] > 1e-9 * interval or len(grid) == 1:
+        grid = np.append(grid, stop_time)
+    else:
+        grid[-1] = stop_time
+    return _increasing(grid, interval)
+
+
+def _increasing(grid: np.ndarray, interval: float | None) -> np.ndarray:
+    """``grid`` if its times are distinct floating-point numbers, else :class:`OptionError`."""
+    if len(grid) > 1 and np.all(np.diff(grid) > 0):
+        return grid
+    step = f"every {interval:g} s" if interval is not None else f"in {len(grid) - 1} steps"
+    raise OptionError(f"the output grid from {grid[0]:g} to {grid[-1]:g} s {step} has points "
+                      "that floating-point numbers cannot tell apart: lengthen the run "
+                      "(--stop-time) or raise the interval (--interval)")
+
+
+# -- values of parameters and start values -------------------------------------------------------
+
+def _bounds(decl: Any) -> tuple[float | None, float | None]:
+    lo, hi = getattr(decl, "min", None), getattr(decl, "max", None)
+    return (None if lo is None else float(lo)), (None if hi is None else float(hi))
+
+
+def _range_text(lo: float | None, hi: float | None) -> str:
+    return (f"[{'-inf' if lo is None else f'{lo:g}'}, {'inf' if hi is None else f'{hi:g}'}]")
+
+
+def _check_one(kind: str, name: str, value: float, decl: Any, where: str) -> None:
+    if not math.isfinite(value):
+        raise ParameterError(f"{kind} {name}{where} is {value}: it must be a finite number")
+    lo, hi = _bounds(decl)
+    if (lo is not None and value < lo) or (hi is not None and value > hi):
+        side = f"below its min = {lo:g}" if lo is not None and value < lo \
+            else f"above its max = {hi:g}"
+        raise ParameterError(f"{kind} {name}{where} = {value:g} is {side} (declared range "
+                             f"{_range_text(lo, hi)})")
+
+
+def check_values(dae: Any, p: np.ndarray, flat: Any = None) -> None:
+    """Parameters, inputs and fixed start values: finite and inside their declared
+    ``min``/``max``. ``flat`` (the reduced flat model) supplies parameters bound to
+    expressions of others and the declarations of the variables."""
+    import casadi as ca
+
+    p = np.asarray(p, dtype=float)
+    n_par = len(dae.parameters)
+    for k, q in enumerate(dae.parameters):
+        _check_one("parameter", q.name, float(p[k]), q.decl, _declared(q))
+    for k, u in enumerate(dae.inputs):
+        _check_one("input", u.name, float(p[n_par + k]), u.decl, _declared(u))
+    bad = [d.name for k, d in enumerate(getattr(dae, "discretes", ()))
+           if not math.isfinite(float(p[n_par + len(dae.inputs) + k]))
+           and not d.name.startswith("$")]
+    if bad:
+        raise ParameterError(f"discrete variable {bad[0]} starts at a non-finite value")
+    if flat is not None:
+        bound = [q for q in flat.parameters if isinstance(q.decl.value, ca.SX)]
+        if bound:
+            values = _bound_values(dae, bound, p)
+            for q, v in zip(bound, values, strict=True):
+                if v is not None:
+                    comp = f", declared in {q.component}" if q.component else ""
+                    _check_one("parameter", q.name, v, q.decl,
+                               f" (bound to other parameters{comp})")
+    decls = {v.name: v for v in flat.variables} if flat is not None else {}
+    for k, value in dae.fixed:
+        name = dae.names[k]
+        v = decls.get(name)
+        _check_one("start value of", name, float(value), v.decl if v is not None else None,
+                   _declared(v) if v is not None else "")
+    for names, starts in ((dae.state_names, dae.x_start), (dae.algebraic_names, dae.z_start)):
+        for name, value in zip(names, np.asarray(starts, dtype=float), strict=False):
+            if not math.isfinite(value):
+                raise ParameterError(f"start value of {name} is {value}: it must be a finite "
+                                     "number")
+
+
+def _declared(v: Any, sep: str = " (") -> str:
+    comp = getattr(v, "component", "")
+    if not comp:
+        return ""
+    return f"{sep}declared in {comp}" + (")" if sep == " (" else "")
+
+
+def _bound_values(dae: Any, bound: list, p: np.ndarray) -> list[float | None]:
+    import casadi as ca
+
+    syms = ca.vertcat(*[q.sx for q in bound])
+    vals = ca.vertcat(*[ca.SX(q.decl.value) for q in bound])
+    for _ in range(len(bound)):
+        if not ca.depends_on(vals, syms):
+            break
+        vals = ca.substitute(vals, syms, vals)
+    try:
+        f = ca.Function("bgm_bound", [dae.p], [vals])
+        out = np.asarray(f(p), dtype=float).ravel()
+    except RuntimeError:              # depends on something else than the parameters
+        return [None] * len(bound)
+    return [float(v) for v in out]
+
+
+# -- command-line model arguments ----------------------------------------------------------------
+
+def parse_model_args(items: Sequence[str]) -> dict[str, Any]:
+    """``--arg NAME=VALUE`` items as keyword arguments (JSON values, else strings)."""
+    out: dict[str, Any] = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise OptionError(f"--arg expects NAME=VALUE, got {item!r}")
+        if not (name.isidentifier() or all(p.isidentifier() for p in name.split("."))):
+            raise OptionError(f"--arg {item!r}: {name!r} is not an argument name")
+        if name in out:
+            raise OptionError(f"--arg {name} is given twice")
+        try:
+            val = json.loads(value)
+        except json.JSONDecodeError:
+            val = value
+        if isinstance(val, float) and not math.isfinite(val):
+            raise OptionError(f"--arg {name}={value}: the value must be a finite number")
+        out[name] = val
+    return out
+
+
+_TYPES = {"int": int, "float": float, "bool": bool, "str": str}
+
+
+def check_model_args(obj: Any, kwargs: dict[str, Any], label: str) -> dict[str, Any]:
+    """Check ``kwargs`` against the signature of the model constructor ``obj`` (names and
+    the types of the defaults or annotations); returns them converted (3.0 -> 3 for an int)."""
+    if not kwargs:
+        return kwargs
+    try:
+        sig = inspect.signature(obj)
+    except (TypeError, ValueError):
+        return kwargs
+    params = sig.parameters
+    var_kw = any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
+    named = {n: p for n, p in params.items()
+             if p.kind in (inspect.Parameter.POSITIONAL_OR_KEYWORD,
+                           inspect.Parameter.KEYWORD_ONLY)}
+    out = dict(kwargs)
+    for name, value in kwargs.items():
+        p = named.get(name)
+        if p is None:
+            if var_kw:
+                continue
+            raise OptionError(f"--arg {name}: {label} takes no argument {name!r}; it takes: "
+                              f"{', '.join(named) or 'none'}")
+        want = _expected_type(p)
+        if want is None:
+            continue
+        if want is int and isinstance(value, float) and value.is_integer():
+            value = int(value)
+        if want is float and isinstance(value, int) and not isinstance(value, bool):
+            value = float(value)
+        if not isinstance(value, want) or (want is int and isinstance(value, bool)):
+            default = "" if p.default is inspect.Parameter.empty else f", default {p.default!r}"
+            shown = value if isinstance(value, str) else json.dumps(value)
+            raise OptionError(f"--arg {name}={shown}: {label} expects {_article(want)} for "
+                              f"{name}{default}")
+        out[name] = value
+    return out
+
+
+def _article(t: type) -> str:
+    return {int: "an integer", float: "a number", bool: "true or false",
+            str: "a string"}[t]
+
+
+def _expected_type(p: inspect.Parameter) -> type | None:
+    ann = p.annotation
+    if isinstance(ann, str):
+        ann = _TYPES.get(ann.strip())
+    if ann in (int, float, bool, str):
+        return ann
+    d = p.default
+    if d is not inspect.Parameter.empty and d is not None and type(d) in (int, float, bool):
+        return type(d)
+    return None
+
+
+# -- output files --------------------------------------------------------------------------------
+
+def check_output_file(path: str | Path, option: str = "-o") -> Path:
+    """Refuse an output path that is a directory, lies under a file, or cannot be written;
+    nothing is created or changed."""
+    path = Path(path)
+    if str(path) == "" or path.name in ("", ".", ".."):
+        raise OptionError(f"{option} {str(path)!r}: not a file name")
+    if path.is_dir():
+        raise OptionError(f"{option} {path}: is an existing directory, not a file")
+    if path.exists() and not path.is_file():
+        import stat
+
+        if not stat.S_ISCHR(path.stat().st_mode):       # /dev/null is fine
+            raise OptionError(f"{option} {path}: exists and is not a regular file")
+    parent = path.parent if str(path.parent) else Path(".")
+    probe = parent
+    while not probe.exists():
+        if probe.parent == probe:
+            break
+        probe = probe.parent
+    if probe.exists() and not probe.is_dir():
+        raise OptionError(f"{option} {path}: {probe} is a file, not a directory")
+    if path.exists():
+        if not os.access(path, os.W_OK):
+            raise OptionError(f"{option} {path}: the file is not writable")
+        return path
+    try:
+        fd, tmp = tempfile.mkstemp(dir=probe, prefix=".bgm-probe-")
+    except OSError as err:
+        raise OptionError(f"{option} {path}: cannot write in {probe} "
+                          f"({err.strerror or err})") from None
+    os.close(fd)
+    os.unlink(tmp)
+    return path
+
+
+def plot_formats() -> list[str]:
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    return sorted(FigureCanvasBase.get_supported_filetypes())
+
+
+def check_plot_file(path: str | Path, option: str = "--plot") -> Path:
+    """A writable plot path whose extension matplotlib can produce."""
+    path = Path(path)
+    fmt = path.suffix.lower().lstrip(".")
+    formats = plot_formats()
+    if not fmt:
+        raise OptionError(f"{option} {path}: no file extension; use one of "
+                          f"{', '.join('.' + f for f in formats)}")
+    if fmt not in formats:
+        raise OptionError(f"{option} {path}: unknown plot format '.{fmt}'; use one of "
+                          f"{', '.join('.' + f for f in formats)}")
+    return check_output_file(path, option)
+
+
+def check_distinct_outputs(*paths: tuple[str, str | Path | None]) -> None:
+    """No two outputs (``(option, path)``) may be the same file."""
+    seen: dict[Path, str] = {}
+    for option, p in paths:
+        if p is None:
+            continue
+        key = Path(p).resolve()
+        if key in seen:
+            raise OptionError(f"{option} {p}: the same file as {seen[key]}")
+        seen[key] = f"{option} {p}"
+
+
+def check_plot_vars(names: Sequence[str], compiled: Any) -> None:
+    """Every name in ``names`` is a variable, alias or parameter of ``compiled``."""
+    import difflib
+
+    dae = compiled.dae
+    known = set(dae.names) | set(getattr(dae, "aliases", {}) or {}) \
+        | set(compiled.flat.aliases) | {q.name for q in compiled.reduced.model.parameters} \
+        | {"time"}
+    for n in names:
+        if n not in known:
+            close = difflib.get_close_matches(n, sorted(known), n=4, cutoff=0.6)
+            hint = f"; did you mean {', '.join(close)}?" if close else ""
+            raise OptionError(f"--plot-vars: {n!r} is not a variable of {compiled.name}{hint}")
+
+
+# -- exceptions raised by user code --------------------------------------------------------------
+
+_PKG = str(Path(__file__).resolve().parent)
+_SYSTEM = {str(Path(p).resolve()) for key in ("stdlib", "platstdlib", "purelib", "platlib")
+           if (p := sysconfig.get_paths().get(key))}
+
+
+def _is_user_file(filename: str) -> bool:
+    if filename.startswith("<"):
+        return False
+    try:
+        f = str(Path(filename).resolve())
+    except OSError:
+        return False
+    if f.startswith(_PKG + os.sep):
+        return False
+    return not any(f.startswith(s + os.sep) for s in _SYSTEM)
+
+
+def user_location(exc: BaseException) -> str:
+    """``file:line (in function)`` of the innermost frame of ``exc``'s traceback in user code
+    (not bgmodelica, not the standard library or installed packages); "" if none."""
+    frames = traceback.extract_tb(exc.__traceback__)
+    if isinstance(exc, SyntaxError) and exc.filename:
+        return f"{_short(exc.filename)}:{exc.lineno}"
+    for fr in reversed(frames):
+        if _is_user_file(fr.filename):
+            return f"{_short(fr.filename)}:{fr.lineno} (in {fr.name})"
+    return ""
+
+
+def _short(filename: str) -> str:
+    try:
+        rel = os.path.relpath(filename)
+    except ValueError:
+        return filename
+    return rel if not rel.startswith("..") else filename
+
+
+def user_error(exc: BaseException, what: str, path: str = "") -> UserCodeError:
+    """A :class:`UserCodeError` for ``exc`` raised by user code while doing ``what``."""
+    loc = user_location(exc)
+    text = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+    msg = f"{what} raised {type(exc).__name__}" + (f": {text}" if text else "") \
+        + (f" at {loc}" if loc else "")
+    err = UserCodeError(msg, path, loc)
+    err.__cause__ = exc
+    return err
+
+
+def nested_user_error(err: UserCodeError, key: str, cls: str) -> UserCodeError:
+    """``err`` raised while building subcomponent ``key`` (class ``cls``): the path grows."""
+    path = f"{key}.{err.path}" if err.path else key
+    detail = getattr(err, "detail", None) or str(err)
+    new = UserCodeError(f"building subcomponent {path}: {detail}", path, err.location)
+    new.detail = detail
+    new.__cause__ = err.__cause__
+    return new
+
+
+def check_export_args(args: Any) -> None:
+    """``bgmodelica export`` options: a finite positive stop time and step, and an output
+    directory that is not a file."""
+    t1 = _real("--stop-time", args.stop_time)
+    if t1 <= 0:
+        raise OptionError(f"--stop-time = {t1:g} must be positive")
+    step = _real("--step", args.step, allow_none=True)
+    if step is not None and step <= 0:
+        raise OptionError(f"--step = {step:g} must be positive")
+    out = Path(args.output)
+    if out.exists() and not out.is_dir():
+        raise OptionError(f"-o {out}: is a file; FMUs are written into a directory")
+
+
+# -- model building --------------------------------------------------------------------------
+
+def guarded_equations(elem: Any, where: str, path: str):
+    """``elem.all_equations()``, with an exception raised by the user's ``equations()``
+    turned into a :class:`UserCodeError` naming the component ``where`` and the user's file
+    and line, and model errors raised there prefixed with ``where``."""
+    from .errors import ConnectError, DeclarationError, EquationError, ModelError
+
+    it = iter(elem.all_equations())
+    while True:
+        try:
+            eq = next(it)
+        except StopIteration:
+            return
+        except UserCodeError:
+            raise
+        except (ConnectError, DeclarationError, EquationError) as err:
+            if str(err).startswith(where):
+                raise
+            try:
+                again = type(err)(f"{where}: {err}")
+            except TypeError:
+                raise err from None
+            raise again from None
+        except ModelError:
+            raise
+        except RecursionError as err:
+            raise user_error(err, f"{where}: equations()", path) from err
+        except Exception as err:  # noqa: BLE001 -- user code: say where, no traceback
+            raise user_error(err, f"{where}: equations()", path) from err
+        yield eq
+
+
+def check_binding(name: str, value: Any, leaves: list, full: dict[int, str]) -> None:
+    """A parameter may be bound to an expression of parameters only: not of time, variables,
+    inputs or discrete variables (they vary during a run). ``leaves``: the symbols of the
+    expression; ``full``: id(symbol) -> dotted name."""
+    from .core.variables import KIND_PARAMETER
+
+    for leaf in leaves:
+        decl = getattr(leaf, "decl", None)
+        if decl is None:               # time
+            raise DeclarationError_(f"parameter {name} is bound to {value!r}, which depends "
+                                    "on time: a parameter is constant during a run; declare "
+                                    f"{name.rpartition('.')[2]} as a Variable with an "
+                                    "equation instead")
+        if decl.kind != KIND_PARAMETER:
+            what = full.get(id(leaf), getattr(leaf, "name", "?"))
+            raise DeclarationError_(
+                f"parameter {name} is bound to {value!r}, which depends on the {decl.kind} "
+                f"{what}: a parameter is constant during a run; bind it to parameters only, "
+                "or declare it as a Variable with an equation")
+
+
+def check_sx_binding(name: str, value: Any) -> None:
+    """:func:`check_binding` for a binding given as a CasADi SX expression."""
+    import casadi as ca
+
+    from .core.variables import TIME, lookup
+
+    for s in ca.symvar(value):
+        if s.element_hash() == TIME.sx.element_hash():
+            check_binding(name, value, [object()], {})
+        sym = lookup(s)
+        if sym is not None:
+            check_binding(name, value, [sym], {id(sym): sym.name})
+
+
+def DeclarationError_(message: str):  # noqa: N802 -- a constructor
+    from .errors import DeclarationError
+
+    return DeclarationError(message)
