@@ -80,3 +80,7 @@ __all__ += ["linearize", "steady_state"]
 from .studies import fit, sweep  # noqa: E402  (Dask and xarray load only when a study runs)
 
 __all__ += ["sweep", "fit"]
+
+from .modelica import export_modelica, load_modelica  # noqa: E402  (lark loads on first use)
+
+__all__ += ["load_modelica", "export_modelica"]

@@ -81,9 +81,11 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     from .compiler import compile
     from .errors import SimulationError
     from .loader import load_model
+    from .modelica.cli import apply_experiment_defaults
     from .simulate import simulate
     from .validate import check_distinct_outputs, check_output_file, check_plot_vars
 
+    apply_experiment_defaults(args)        # .mo models: experiment annotation defaults
     _check_simulate_args(args)
     params = _parse_sets(args.set)
     model = load_model(args.model, **_model_kwargs(args.arg))
@@ -256,13 +258,16 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     def model_args(p: argparse.ArgumentParser) -> None:
-        p.add_argument("model", help="path/file.py:Name or package.module:Name")
+        p.add_argument("model", help="path/file.py:Name, package.module:Name or "
+                                     "file.mo:Package.Model (Modelica text)")
         p.add_argument("--arg", action="append", default=[], metavar="NAME=VALUE",
                        help="argument for a parameterized model constructor (e.g. n=100)")
 
     sim = sub.add_parser("simulate", help="simulate a model, write CSV (and a plot)")
     model_args(sim)
-    sim.add_argument("--stop-time", type=float, default=1.0, help="[s] (default 1)")
+    sim.add_argument("--stop-time", type=float, default=None,
+                     help="[s] (default: the experiment annotation of a Modelica model, "
+                          "else 1)")
     sim.add_argument("--interval", type=float, default=None, help="output step [s]")
     sim.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                      help="override a parameter / input / start value by dotted name")
@@ -276,7 +281,9 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("-o", "--output", help="CSV file (default <Model>.csv)")
     sim.add_argument("--plot", help="PNG file with the states (or --plot-vars)")
     sim.add_argument("--plot-vars", nargs="+", help="variables to plot")
-    sim.add_argument("--rtol", type=float, default=1e-6)
+    sim.add_argument("--rtol", type=float, default=None,
+                     help="relative tolerance (default: the experiment annotation's "
+                          "Tolerance of a Modelica model, else 1e-6)")
     sim.add_argument("--atol", type=float, default=1e-8)
     sim.add_argument("--solver", choices=("idas", "cvodes", "auto"), default="idas",
                      help="integrator: IDAS (DAEs, default), CVODES (explicit ODEs) or auto "
@@ -337,6 +344,10 @@ from .cli_tools import register as register_tools  # noqa: E402
 
 _EXTENSIONS.append(register_tools)
 
+from .modelica.cli import register as register_modelica  # noqa: E402
+
+_EXTENSIONS.append(register_modelica)
+
 
 def _autocomplete(parser: argparse.ArgumentParser) -> None:
     from .cli_tools import autocomplete
@@ -360,7 +371,7 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
 
 #: commands whose stderr (solver chatter, warnings) is held back and shown only on success,
 #: so that an error is the one line on stderr
-_HOLD_STDERR = {"simulate", "check", "export", "draw", "linearize"}
+_HOLD_STDERR = {"simulate", "check", "export", "draw", "linearize", "export-mo"}
 
 
 def _error_line(err: BaseException) -> str:

@@ -163,11 +163,11 @@ def _compile(model: Component, select: Selector | None, units: str = "error") ->
     lap("alias")
     try:
         balance = check_balance(flat)
+        lap("balance")
+        return _reduce_and_build(flat, balance, n_flat, timings, model, select)
     except UnbalancedModelError:
         check_references(raw, force=True)  # large models: the likely cause, if it is that
         raise
-    lap("balance")
-    return _reduce_and_build(flat, balance, n_flat, timings, model, select)
 
 
 def recompile(compiled: CompiledModel, select: Selector) -> CompiledModel:

@@ -35,6 +35,9 @@ def _expr_text(expr: Any, names: dict[int, str]) -> str:
 
 
 def _value(v: Any) -> Any:
+    """A number, or None for an expression (a bound parameter)."""
+    if isinstance(v, ca.SX) and not v.is_constant():
+        return None                      # float() of a symbolic SX is nan, not an error
     try:
         return float(v)
     except (TypeError, ValueError, RuntimeError):

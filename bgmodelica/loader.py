@@ -20,10 +20,14 @@ def load_model(ref: str, **kwargs: Any) -> Component:
     ``Name`` is a Component class or a function returning a Component; ``kwargs`` are passed
     to it (e.g. ``n=100`` for a parameterized example).
     """
+    from .modelica import is_reference, load_reference
+
+    if is_reference(ref):                  # Modelica text: file.mo:Package.Model
+        return load_reference(ref, **kwargs)
     target, sep, name = ref.rpartition(":")
     if not sep or not target or not name:
-        raise ModelLoadError(f"model reference {ref!r} must be 'path/file.py:Name' or "
-                             "'package.module:Name'")
+        raise ModelLoadError(f"model reference {ref!r} must be 'path/file.py:Name', "
+                             "'package.module:Name' or 'file.mo:Package.Model'")
     module = _load_module(target)
     if not hasattr(module, name):
         public = [n for n, v in vars(module).items() if not n.startswith("_") and (

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import OptionError, ParameterError, UserCodeError
+from .errors import DeclarationError, OptionError, ParameterError, UserCodeError
 
 #: output grids with more points than this are refused whatever the memory
 MAX_OUTPUT_POINTS = 50_000_000
@@ -106,6 +106,8 @@ def check_run_options(*, start_time: Any = 0.0, stop_time: Any = 1.0, interval: 
     ms = _real("max_step", max_step, allow_none=True)
     if ms is not None and ms <= 0:
         raise OptionError(f"max_step = {ms:g} must be positive")
+    if isinstance(max_steps, float) and max_steps.is_integer():
+        max_steps = int(max_steps)                # 1e6
     if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)) \
             or max_steps < 1:
         raise OptionError(f"max_steps must be a positive integer, got {max_steps!r}")
@@ -501,7 +503,7 @@ def guarded_equations(elem: Any, where: str, path: str):
     """``elem.all_equations()``, with an exception raised by the user's ``equations()``
     turned into a :class:`UserCodeError` naming the component ``where`` and the user's file
     and line, and model errors raised there prefixed with ``where``."""
-    from .errors import ConnectError, DeclarationError, EquationError, ModelError
+    from .errors import ConnectError, EquationError, ModelError
 
     it = iter(elem.all_equations())
     while True:
@@ -521,8 +523,6 @@ def guarded_equations(elem: Any, where: str, path: str):
             raise again from None
         except ModelError:
             raise
-        except RecursionError as err:
-            raise user_error(err, f"{where}: equations()", path) from err
         except Exception as err:  # noqa: BLE001 -- user code: say where, no traceback
             raise user_error(err, f"{where}: equations()", path) from err
         yield eq
@@ -537,13 +537,13 @@ def check_binding(name: str, value: Any, leaves: list, full: dict[int, str]) -> 
     for leaf in leaves:
         decl = getattr(leaf, "decl", None)
         if decl is None:               # time
-            raise DeclarationError_(f"parameter {name} is bound to {value!r}, which depends "
-                                    "on time: a parameter is constant during a run; declare "
-                                    f"{name.rpartition('.')[2]} as a Variable with an "
-                                    "equation instead")
+            raise DeclarationError(f"parameter {name} is bound to {value!r}, which depends "
+                                   "on time: a parameter is constant during a run; declare "
+                                   f"{name.rpartition('.')[2]} as a Variable with an "
+                                   "equation instead")
         if decl.kind != KIND_PARAMETER:
             what = full.get(id(leaf), getattr(leaf, "name", "?"))
-            raise DeclarationError_(
+            raise DeclarationError(
                 f"parameter {name} is bound to {value!r}, which depends on the {decl.kind} "
                 f"{what}: a parameter is constant during a run; bind it to parameters only, "
                 "or declare it as a Variable with an equation")
@@ -562,8 +562,3 @@ def check_sx_binding(name: str, value: Any) -> None:
         if sym is not None:
             check_binding(name, value, [sym], {id(sym): sym.name})
 
-
-def DeclarationError_(message: str):  # noqa: N802 -- a constructor
-    from .errors import DeclarationError
-
-    return DeclarationError(message)

@@ -26,6 +26,10 @@ filtered through (I - h gamma J)^-1 so stiff components do not cause needless re
 Tunable parameters ``solver.tolerance`` (default: the spec's ``tolerance``, 1e-6; the tighter of
 it and a tolerance passed by the importer is used) and ``solver.max_step`` (default: the
 experiment length) control it; inputs are held over each communication step.
+
+Models with events: :mod:`~bgmodelica.fmi.hybrid` generates the native event functions into the
+FMU and ``templates/bgm_events.c`` ports the native event loop (event indicators and event
+iteration for Model Exchange, event location inside ``DoStep`` for Co-Simulation).
 """
 
 from .build import FmuBuildError

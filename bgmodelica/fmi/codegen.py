@@ -117,14 +117,15 @@ def build_functions(spec: FmuSpec, prefix: str) -> ModelFunctions:
                 [f.name_out(i) for i in range(f.n_out())])))
     init = initfwd = None
     if spec.init is not None:
-        (x0,) = _call(spec.init, [t, u, p])
-        init = ca.Function(f"{prefix}init", [t, u, p], [x0], ["t", "u", "p"], ["x0"])
-        xdot0, y0 = _call(ode, [t, x0, u, p])
+        (x0,) = _call(spec.init, [t, u, p] + ds)
+        init = ca.Function(f"{prefix}init", [t, u, p] + ds, [x0], ["t", "u", "p"] + dn,
+                           ["x0"])
+        xdot0, y0 = _call(ode, [t, x0, u, p] + ds)
         all0 = ca.vertcat(x0, xdot0, y0)
         sens0 = ca.densify(ca.jtimes(all0, ca.vertcat(u, p), ca.vertcat(du, dp)))
-        initfwd = ca.Function(f"{prefix}initfwd", [t, u, p, du, dp],
+        initfwd = ca.Function(f"{prefix}initfwd", [t, u, p, du, dp] + ds,
                               [sens0[:nx], sens0[nx:2 * nx], sens0[2 * nx:]],
-                              ["t", "u", "p", "du", "dp"], ["dx0", "dxdot0", "dy0"])
+                              ["t", "u", "p", "du", "dp"] + dn, ["dx0", "dxdot0", "dy0"])
     return ModelFunctions(ode, fwd, jacx, xdot_only, init, initfwd, events)
 
 
@@ -180,9 +181,10 @@ def dependencies(spec: FmuSpec, funcs: ModelFunctions) -> Dependencies:
         t = ca.MX.sym("t")
         u = ca.MX.sym("u", spec.nu)
         p = ca.MX.sym("p", spec.np)
-        (x0,) = _call(funcs.init, [t, u, p])
-        xdot0, y0 = _call(ode, [t, x0, u, p])
-        total = ca.Function("bgm_total_init", [t, u, p], [x0, xdot0, y0])
+        ds = [ca.MX.sym("d", spec.hybrid.nd)] if spec.hybrid is not None else []
+        (x0,) = _call(funcs.init, [t, u, p] + ds)
+        xdot0, y0 = _call(ode, [t, x0, u, p] + ds)
+        total = ca.Function("bgm_total_init", [t, u, p] + ds, [x0, xdot0, y0])
         empty: list[list[int]] = []
         trip = []
         for oind, n in ((0, nx), (1, nx), (2, ny)):

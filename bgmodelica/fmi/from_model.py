@@ -14,6 +14,11 @@ outputs and locals (an alias gets the range of the variable it stands for, mirro
 sign is negative); the FMU refuses parameter, input and state start values outside them. A
 default value outside its own range is refused at export (:class:`FmuSpecError`); a
 consistent initial state within 1e-9 (relative) of a bound is put on the bound.
+
+Models with events (relations, ``when``, ``sample``, tables) export with the event runtime of
+:mod:`bgmodelica.fmi.hybrid`: ``ode`` then takes the discrete slots ``d`` as a fifth argument,
+discrete variables are exported with their FMI types, and the start state is the native one
+(relations at their values at the start time).
 """
 
 from __future__ import annotations
@@ -191,18 +196,17 @@ def fmu_spec(model: Component | CompiledModel, *, stop_time: float = 1.0,
     if hybrid:
         from .hybrid import build_hybrid
 
-        if initial_state_function(dae, p_all) is not None:
-            raise FmuSpecError(
-                f"cannot export {compiled.name} as an FMU: its initial state follows from "
-                "conditions through the model's equations (fixed start values of non-states "
-                "or initial equations), which the event runtime of the FMU does not solve "
-                "yet; fix the start values of the states instead")
         hyb_spec = build_hybrid(dae, flat, by_name, z_of,
                                 lambda p_, u_, d_: ca.vertcat(p_, u_, d_))
+        # the initial state also depends on the discrete slots (relations at the start)
+        f0 = initial_state_function(dae, p_init)
+        init = None if f0 is None else ca.Function(
+            "init", [t, u, p, d], [f0(t, ca.vertcat(p, u, d))], ["t", "u", "p", "d"], ["x0"])
+    else:
+        init = _init_function(dae, p_all, t, u, p)
     return FmuSpec(model_name=name, description=f"{compiled.name} (bgmodelica)",
                    states=state_vars, inputs=inputs, parameters=params, outputs=outputs,
-                   locals=locals_, ode=ode,
-                   init=None if hybrid else _init_function(dae, p_all, t, u, p),
+                   locals=locals_, ode=ode, init=init,
                    stop_time=stop_time,
                    step_size=step_size, tolerance=tolerance, hybrid=hyb_spec)
 

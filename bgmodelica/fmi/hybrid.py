@@ -133,9 +133,9 @@ def check_exportable(dae: CasadiDAE, name: str) -> None:
                 raise FmuSpecError(
                     f"cannot export {name} as an FMU: reinit({var}, ...) restarts a variable "
                     "that index reduction demoted from the states (the native simulation "
-                    "re-initializes it with a nonlinear solve, which the FMU runtime does not "
-                    f"carry). States: {', '.join(dae.state_names)}; choose {var} as a state "
-                    "with state_select=StateSelect.PREFER")
+                    "re-initializes the states consistently with a nonlinear solve, which the "
+                    "FMU's event runtime does not carry); the FMU can restart its states "
+                    f"({', '.join(dae.state_names)}) only")
 
 
 def consistent_start(dae: CasadiDAE, p: np.ndarray):
@@ -217,7 +217,18 @@ def build_hybrid(dae: CasadiDAE, flat, by_name: dict, z_of, pfull_of) -> HybridS
     args, names = [t, x, u, p, d], ["t", "x", "u", "p", "d"]
     step = ca.Function("evstep", args, [g, dgdt, cond, assign, reinit, pre, dv], names,
                        ["g", "dgdt", "cond", "assign", "reinit", "pre", "dv"])
-    indicators = ca.Function("evind", args, [fn.indicators(t, x, z, pfull)], names, ["z"])
+    # relations on inputs (constant for the native loop, which feeds inputs as time tables)
+    # change with the importer's inputs: state events in the FMU
+    u_sx = dae.p[np_:nb]
+    on_input = [k for k in fn.time_rel
+                if nu and ca.depends_on(hyb.relations[k].indicator, u_sx)]
+    state_rel = sorted(list(fn.state_rel) + on_input)
+    time_rel = [k for k in fn.time_rel if k not in on_input]
+    if on_input:
+        ind = g[state_rel] if state_rel else ca.MX(0, 1)
+    else:
+        ind = fn.indicators(t, x, z, pfull)
+    indicators = ca.Function("evind", args, [ind], names, ["z"])
     samp = ca.vertcat(*[ca.vertcat(s.start, s.interval) for s in hyb.samples]) \
         if hyb.samples else ca.SX(0, 1)
     samp_f = ca.Function("samp", [dae.p], [ca.densify(samp)])
@@ -243,7 +254,7 @@ def build_hybrid(dae: CasadiDAE, flat, by_name: dict, z_of, pfull_of) -> HybridS
         relations=[r.text for r in hyb.relations],
         rel_slot=[int(s) - nb for s in fn.rel_slot],
         rel_strict=[bool(s) for s in fn.strict],
-        state_rel=list(fn.state_rel), time_rel=list(fn.time_rel),
+        state_rel=state_rel, time_rel=time_rel,
         whens=[list(ids) for ids in fn.branch_of],
         assigns=[[(pidx - nb, pos) for pidx, pos in branch] for branch in fn.assign_of],
         reinits=reinits,

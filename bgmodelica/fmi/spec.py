@@ -90,8 +90,8 @@ class FmuSpec:
     step_size: float | None = None
     tolerance: float = 1e-6
     solver_max_step: float | None = None
-    #: models with events: a :class:`bgmodelica.fmi.hybrid.HybridSpec`; then ``ode`` takes the
-    #: discrete slots as a fifth argument ``(t, x, u, p, d)`` and ``init`` must be None
+    #: models with events: a :class:`bgmodelica.fmi.hybrid.HybridSpec`; then ``ode`` (and
+    #: ``init``) take the discrete slots as their last argument ``(t, x, u, p, d)``
     hybrid: Any = None
 
     @property
@@ -127,10 +127,8 @@ class FmuSpec:
             raise FmuSpecError("FmuSpec.ode is missing")
         n_in = [1, self.nx, self.nu, self.np] + ([self.hybrid.nd] if self.hybrid else [])
         _check_function(self.ode, "ode", n_in, [self.nx, self.ny])
-        if self.hybrid is not None and self.init is not None:
-            raise FmuSpecError("a hybrid spec cannot have an init function")
         if self.init is not None:
-            _check_function(self.init, "init", [1, self.nu, self.np], [self.nx])
+            _check_function(self.init, "init", n_in[:1] + n_in[2:], [self.nx])
         seen: dict[str, str] = {}
         groups = (("state", self.states), ("input", self.inputs), ("parameter", self.parameters),
                   ("output", self.outputs), ("local", self.locals))

@@ -54,7 +54,9 @@ def _load(stored: Any, name: str | None, kwargs: dict[str, Any]):
     except ModelError:
         raise
     exp = B.experiment(scope)
-    object.__setattr__(model, "experiment", exp)
+    object.__setattr__(model, "_mo_experiment", exp)
+    if "experiment" not in model._symbols and "experiment" not in model._children:
+        object.__setattr__(model, "experiment", exp)
     object.__setattr__(model, "_mo_source", (stored.file, name))
     return model
 
@@ -94,7 +96,9 @@ def list_models(path: str | Path) -> list[str]:
 def experiment_of(model: Any) -> dict[str, float]:
     """Keyword arguments for :func:`bgmodelica.simulate` from a loaded model's experiment
     annotation: ``stop_time``, ``start_time``, ``interval``, ``rtol`` (those given)."""
-    exp = getattr(model, "experiment", None) or {}
+    exp = model.__dict__.get("_mo_experiment") or getattr(model, "experiment", None) or {}
+    if not isinstance(exp, dict):
+        exp = {}
     out: dict[str, float] = {}
     for key, arg in (("StartTime", "start_time"), ("StopTime", "stop_time"),
                      ("Interval", "interval"), ("Tolerance", "rtol")):
@@ -109,3 +113,25 @@ def export_modelica(model: Any, path: str | Path | None = None, **options: Any) 
     from .export import export_modelica as _export
 
     return _export(model, path, **options)
+
+
+def is_reference(ref: str) -> bool:
+    """Whether a MODEL reference names a Modelica file (``file.mo:Package.Model`` or
+    ``file.mo``)."""
+    path, sep, _ = ref.rpartition(":")
+    return ref.lower().endswith(".mo") or bool(sep) and path.lower().endswith(".mo")
+
+
+def load_reference(ref: str, **modifiers: Any):
+    """Load ``file.mo:Package.Model`` (or ``file.mo`` defining one model); ``modifiers`` as
+    in :func:`load_modelica` (``--arg n=100`` on the command line)."""
+    if ref.lower().endswith(".mo"):
+        path, name = ref, None
+    else:
+        path, _, name = ref.rpartition(":")
+    p = Path(path)
+    if p.is_dir():
+        raise ModelicaError(f"Modelica file {path} is a directory; name a .mo file")
+    if not p.is_file():
+        raise ModelicaError(f"Modelica file {path} does not exist")
+    return load_modelica(p, name or None, **modifiers)

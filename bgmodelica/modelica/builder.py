@@ -25,10 +25,10 @@ import re
 from dataclasses import replace
 from typing import Any
 
-from ..core.component import Component, Connection, Connector, Element, connect
-from ..core.expr import Equation, Expr, Leaf, Op
 from ..core import expressions as X
 from ..core import hybrid as H
+from ..core.component import Component, Connector, Element, connect
+from ..core.expr import Equation, Expr, Leaf, Op
 from ..core.variables import (
     KIND_PARAMETER,
     TIME,
@@ -77,7 +77,7 @@ def fail(lex: S.ClassScope | None, node: Any, message: str) -> ModelicaError:
     return ModelicaError(f"{_where(lex, pos)}: {message}")
 
 
-# -- modifications --------------------------------------------------------------------------------
+# -- modifications -----------------------------------------------------------------------------
 
 
 class Mod:
@@ -139,7 +139,8 @@ def _pick(whole: Any, index: tuple, mod: Mod) -> Any:
     return out
 
 
-def mod_from_ast(ast_mod: A.Modification | None, scope: Any, lex: S.ClassScope | None) -> Mod | None:
+def mod_from_ast(ast_mod: A.Modification | None, scope: Any,
+                 lex: S.ClassScope | None) -> Mod | None:
     """The :class:`Mod` of a parsed modification, evaluated later in ``scope``."""
     if ast_mod is None:
         return None
@@ -217,7 +218,7 @@ def index_mod(mod: Mod | None, index: tuple) -> Mod | None:
     return m
 
 
-# -- class views -----------------------------------------------------------------------------------
+# -- class views -------------------------------------------------------------------------------
 
 
 class TypeRef:
@@ -267,6 +268,9 @@ class ClassView:
         self.classes: dict[tuple, type] = {}
         self.description = scope.cdef.description
         self.unsupported: list[tuple[A.Unsupported, S.ClassScope]] = []
+        self.plan: tuple | None = None
+        self.checked = False
+        self.validated = False
 
 
 def class_view(scope: S.ClassScope, _stack: tuple = ()) -> ClassView:
@@ -432,7 +436,7 @@ def _tref_of(got: Any, name: str, pos: A.Pos, where: S.ClassScope, depth: int = 
     raise fail(where, pos, f"{name} is not a type")
 
 
-# -- environments -----------------------------------------------------------------------------------
+# -- environments ------------------------------------------------------------------------------
 
 
 class Env:
@@ -440,7 +444,7 @@ class Env:
     Python element once created, and memoized values of its parameters."""
 
     __slots__ = ("view", "mods", "parent", "inst", "path", "_num", "_emod", "disabled",
-                 "_busy")
+                 "_busy", "cached")
 
     def __init__(self, view: ClassView, mods: dict[str, Mod], parent: Env | None,
                  path: str) -> None:
@@ -453,6 +457,7 @@ class Env:
         self._emod: dict[str, Mod | None] = {}
         self.disabled: set[str] = set()
         self._busy: set[str] = set()
+        self.cached: tuple | None = None
 
     def emod(self, name: str) -> Mod | None:
         """The merged modification of element ``name``: the outer one on top of the
@@ -570,7 +575,7 @@ class Ctx:
         self.numeric = numeric
 
 
-# -- expression evaluation -----------------------------------------------------------------------------
+# -- expression evaluation ---------------------------------------------------------------------
 
 
 def evaluate(node: Any, ctx: Ctx) -> Any:
@@ -599,6 +604,23 @@ def _ev_ref(node: A.Ref, ctx: Ctx) -> Any:
     name, subs = parts[0]
     env = ctx.env
     rest = 1
+    if not ctx.numeric and env is not None and env.inst is not None and name not in ctx.loops:
+        hit = env.inst.__dict__["_mo_members"].get(name)
+        if hit is not None:
+            val = hit
+            if subs:
+                val = _subscript(val, subs, ctx, node)
+            for name, subs in parts[1:]:
+                if isinstance(val, Element):
+                    val = member(val, name, False, ctx.lex, node)
+                elif isinstance(val, list):
+                    val = _map_member(val, name, ctx, node)
+                else:
+                    raise fail(ctx.lex, node, f"{node.dotted}: cannot select {name!r} from a "
+                               f"{type(val).__name__}")
+                if subs:
+                    val = _subscript(val, subs, ctx, node)
+            return val
     if name in ctx.loops:
         val = ctx.loops[name]
     elif env is None and len(parts) == 1:
@@ -695,6 +717,22 @@ def _env_member(env: Env, name: str, ctx: Ctx, node: Any) -> Any:
 def member(elem: Element, name: str, numeric: bool = False, lex: Any = None,
            node: Any = None) -> Any:
     """Element ``name`` of an instance: a leaf, a child, an array of them, or a constant."""
+    d = elem.__dict__
+    cache = d.get("_mo_members")
+    if cache is None:
+        cache = {}
+        object.__setattr__(elem, "_mo_members", cache)
+    if not numeric:
+        hit = cache.get(name)
+        if hit is not None:
+            return hit
+        val = _member(elem, name, False, lex, node)
+        cache[name] = val
+        return val
+    return _member(elem, name, numeric, lex, node)
+
+
+def _member(elem: Element, name: str, numeric: bool, lex: Any, node: Any) -> Any:
     env = elem.__dict__.get("_mo_env")
     if env is not None and name in env.view.elements:
         if name in env.disabled:
@@ -742,6 +780,15 @@ def _assemble(elem: Element, name: str, dims: tuple[int, ...]) -> list:
 def _subscript(val: Any, subs: tuple, ctx: Ctx, node: Any) -> Any:
     idx = []
     for s in subs:
+        if type(s) is A.Num and type(s.value) is int:
+            idx.append(s.value)
+            continue
+        if type(s) is A.Ref and len(s.parts) == 1 and s.parts[0][1] is None \
+                and s.parts[0][0] in ctx.loops:
+            v = ctx.loops[s.parts[0][0]]
+            if type(v) is int:
+                idx.append(v)
+                continue
         if isinstance(s, A.Colon):
             idx.append(None)
             continue
@@ -1451,7 +1498,7 @@ _EVAL: dict[type, Any] = {
 }
 
 
-# -- numeric values ---------------------------------------------------------------------------
+# -- numeric values ----------------------------------------------------------------------------
 
 
 _NUM_OPS = {
@@ -1485,14 +1532,13 @@ def numeric_value(v: Any, lex: Any = None, node: Any = None) -> Any:
         owner = getattr(sym, "owner", None)
         env = owner.__dict__.get("_mo_env") if owner is not None else None
         if env is not None:
+            if sym.name in env.view.elements:
+                return env.numeric(sym.name)
             m = _NAME.match(sym.name)
-            if m is None:
-                if sym.name in env.view.elements:
-                    return env.numeric(sym.name)
-            else:
+            if m is not None and m.group(1) in env.view.elements:
                 whole = env.numeric(m.group(1))
                 for i in (int(x) for x in m.group(2).split(",")):
-                    whole = whole[i - 1]
+                    whole = whole[i - 1] if isinstance(whole, list) else whole
                 return whole
         return numeric_value(decl.value, lex, node)
     if isinstance(v, Op):
@@ -1506,7 +1552,7 @@ def numeric_value(v: Any, lex: Any = None, node: Any = None) -> Any:
     raise NotConstant(repr(v))
 
 
-# -- equations ---------------------------------------------------------------------------------------
+# -- equations ---------------------------------------------------------------------------------
 
 
 def _is_number(v: Any) -> bool:
@@ -1692,7 +1738,7 @@ def _eval_when(eq: A.EqWhen, ctx: Ctx) -> Any:
     return result
 
 
-# -- instantiation -------------------------------------------------------------------------------
+# -- instantiation -----------------------------------------------------------------------------
 
 
 _ATTRS = ("start", "fixed", "min", "max", "nominal", "stateSelect", "unit", "quantity",
@@ -1797,7 +1843,7 @@ def _static_decl(info: ElemInfo, tref: TypeRef, idx: tuple, connector: bool) -> 
         return info.defaults[key]
     m = merge(info.mod, tref.mod)
     m = index_mod(m, idx) if idx else m
-    static = True
+    static = "parameter" in info.comp.prefixes or m is None or not m.has_binding
     try:
         attrs = _attr_values(_static_only(m), True, info.lex, info.comp)
         value = None
@@ -1808,7 +1854,7 @@ def _static_decl(info: ElemInfo, tref: TypeRef, idx: tuple, connector: bool) -> 
                 value = attrs["start"]
             else:
                 value = _default_value(tref)
-    except NotConstant:
+    except (NotConstant, ModelicaError):       # needs the instance (or its modifiers)
         static = False
         attrs = {}
         value = _default_value(tref) if "parameter" in info.comp.prefixes else None
@@ -1816,7 +1862,7 @@ def _static_decl(info: ElemInfo, tref: TypeRef, idx: tuple, connector: bool) -> 
             attrs = {k: v for k, v in _attr_values(_static_only(m, keep_units=True), True,
                                                    info.lex, info.comp).items()
                      if k == "unit"}
-        except NotConstant:
+        except (NotConstant, ModelicaError):
             attrs = {}
     decl = _make_decl(info, tref, attrs, value, connector, info.lex)
     info.defaults[key] = (decl, static)
@@ -1869,10 +1915,6 @@ def _instance_decl(env: Env, info: ElemInfo, tref: TypeRef, idx: tuple,
             value = attrs["start"]
         else:
             value = _default_value(tref)
-    elif m is not None and m.has_binding:
-        raise fail(m.lex or info.lex, m.pos, f"{info.comp.name}: a declaration equation "
-                   f"('{info.comp.name} = ...') on a variable is supported only for parameters "
-                   "and constants; write it as an equation")
     return _make_decl(info, tref, attrs, value, connector, info.lex)
 
 
@@ -1895,7 +1937,9 @@ def _check_supported(view: ClassView, where: S.ClassScope) -> None:
 def instantiate(view: ClassView, mods: dict[str, Mod], parent: Env | None, path: str,
                 where: S.ClassScope | None = None, pos: A.Pos = (0, 0)) -> Element:
     """Build the bgmodelica element of ``view`` with modifications ``mods``."""
-    _check_supported(view, where or view.scope)
+    if not view.checked:
+        _check_supported(view, where or view.scope)
+        view.checked = True
     env = Env(view, mods, parent, path)
     connector = "connector" in view.kind
     for name in mods:
@@ -1904,11 +1948,149 @@ def instantiate(view: ClassView, mods: dict[str, Mod], parent: Env | None, path:
             raise fail(m.lex or where, m.pos if m.pos != (0, 0) else pos,
                        f"{view.scope.full_name} has no element {name!r} to modify; it has: "
                        f"{', '.join(view.elements) or 'none'}")
+    plan = view.plan
+    if plan is not None and not any(m.redeclare is not None for m in mods.values()):
+        arrays, scalars, children, cls = plan
+        arrays = dict(arrays)
+    else:
+        arrays, scalars, children, cls = _plan(view, env, connector)
+        view = env.view
+    try:
+        inst = cls()
+    except ModelError as err:
+        raise fail(where or view.scope, pos, str(err)) from None
+    env.inst = inst
+    object.__setattr__(inst, "_mo_env", env)
+    object.__setattr__(inst, "_mo_members", {})
+    if arrays:
+        object.__setattr__(inst, "_mo_arrays", arrays)
+    # subcomponents (their modifiers may refer to this instance's parameters)
+    for info, tref, dims in children:
+        name = info.comp.name
+        m = env.emod(name)
+        for idx in _indices(dims):
+            cname = _elem_name(name, idx)
+            cm = index_mod(m, idx) if idx else m
+            child = _make_child(tref, cm, env, _join(path, cname), info)
+            _add_child(inst, cname, child, info)
+        if dims:
+            arrays_of = inst.__dict__.get("_mo_arrays")
+            if arrays_of is None:
+                arrays_of = {}
+                object.__setattr__(inst, "_mo_arrays", arrays_of)
+            arrays_of[name] = dims
+    # instance-specific declarations
+    emods = env.mods
+    bindings: list[tuple[Any, Mod, ElemInfo]] = []
+    for info, tref, idx, ename in scalars:
+        name = info.comp.name
+        default, static = info.defaults[idx]
+        sym = inst._symbols[ename]
+        if static:
+            outer = emods.get(name)
+            if outer is None:
+                continue
+            m = index_mod(outer, idx) if idx else outer
+            sym.decl = _override(default, m, info, tref)
+        else:
+            sym.decl = _instance_decl(env, info, tref, idx, connector)
+            m = env.emod(name)
+            m = index_mod(m, idx) if idx and m is not None else m
+        if m is not None and m.has_binding and sym.decl.kind != KIND_PARAMETER:
+            bindings.append((sym, m, info))
+    if bindings:
+        _declaration_equations(inst, bindings, connector)
+    if not view.validated:
+        # evaluate the equations of the first instance of each class now, so that unknown
+        # names, bad calls and wrong connects are reported when the model is loaded
+        view.validated = True
+        if not connector:
+            # kept for the first flattening (it would evaluate them again otherwise)
+            env.cached = (equations_of(env, view.equations),
+                          equations_of(env, view.initial, initial=True))
+    return inst
+
+
+def _declaration_equations(inst: Element, bindings: list, connector: bool) -> None:
+    """``Real x = expr`` (in the class or from a modifier): the equation ``x = expr``,
+    evaluated where the binding is written."""
+    eqs: list = []
+    for sym, m, info in bindings:
+        lex = m.lex or info.lex
+        if connector:
+            raise fail(lex, m.pos, f"{info.comp.name}: a connector variable cannot have a "
+                       "declaration equation")
+        try:
+            value = m.value(False)
+        except NotConstant as err:
+            raise fail(lex, m.pos, f"{info.comp.name}: {err.what}") from None
+        _equation(sym.leaf, value, Ctx(None, lex, {}, False), m, eqs)
+    inst._equations.extend(eqs)
+
+
+_FIELDS = {"start": "start", "fixed": "fixed", "min": "min", "max": "max",
+           "nominal": "nominal", "stateSelect": "state_select", "unit": "unit"}
+
+
+def _override(decl: Any, m: Mod, info: ElemInfo, tref: TypeRef) -> Any:
+    """``decl`` (complete without instance) with an outer modification applied."""
+    changes: dict[str, Any] = {}
+    comp = info.comp
+    if m.has_binding and decl.kind == KIND_PARAMETER:
+        try:
+            value = m.value(False)
+        except NotConstant as err:
+            raise fail(m.lex or info.lex, m.pos, f"{comp.name}: {err.what}") from None
+        if isinstance(value, S.EnumValue):
+            value = float(value.index)
+        elif _is_number(value):
+            value = float(value)
+        elif isinstance(value, (list, Element, str)):
+            raise fail(m.lex or info.lex, m.pos, f"parameter {comp.name} is bound to "
+                       f"{type(value).__name__} {value!r}")
+        changes["value"] = value
+    if m.sub:
+        attrs = _attr_values(m, True, info.lex, comp)
+        for k, v in attrs.items():
+            f = _FIELDS.get(k)
+            if f is None or (decl.kind == KIND_PARAMETER and k not in ("min", "max", "start",
+                                                                       "unit")):
+                continue
+            if k == "start" and decl.kind == KIND_PARAMETER:
+                if "value" not in changes and not m.has_binding:
+                    changes["value"] = float(v)
+                continue
+            if k == "stateSelect":
+                if not isinstance(v, S.EnumValue):
+                    raise fail(info.lex, comp, f"{comp.name}: stateSelect must be a "
+                               "StateSelect value")
+                v = StateSelect[v.literal.upper()]
+            elif k == "fixed":
+                v = bool(v)
+            elif k == "unit":
+                if tref.base != "Real":
+                    continue
+            elif k == "start" and tref.base == "Boolean" and isinstance(v, bool):
+                pass
+            else:
+                v = v.index if isinstance(v, S.EnumValue) else v
+                if not _is_number(v):
+                    raise fail(info.lex, comp, f"{comp.name}: {k} = {v!r} is not a number")
+                v = float(v)
+            changes[f] = v
+    return replace(decl, **changes) if changes else decl
+
+
+def _plan(view: ClassView, env: Env, connector: bool) -> tuple:
+    """The structure of one instance: declarations (array sizes and conditional components
+    evaluated), subcomponents, and the Python class. Cached on the view when it cannot depend
+    on the instance (no arrays, no conditions)."""
     decls: dict[str, Any] = {}
     arrays: dict[str, tuple[int, ...]] = {}
     scalars: list[tuple[ElemInfo, TypeRef, tuple, str]] = []
     children: list[tuple[ElemInfo, TypeRef, tuple]] = []
     consts: list[str] = []
+    cacheable = True
     for name, info in view.elements.items():
         comp = info.comp
         bad = comp.element_prefixes & {"inner", "outer"}
@@ -1916,6 +2098,7 @@ def instantiate(view: ClassView, mods: dict[str, Mod], parent: Env | None, path:
             raise fail(info.lex, comp, f"unsupported Modelica construct: {'/'.join(sorted(bad))}"
                        f" ({comp.name})")
         if comp.condition is not None:
+            cacheable = False
             try:
                 on = numeric_value(evaluate(comp.condition, Ctx(env, info.lex, {}, True)),
                                    info.lex, comp.condition)
@@ -1930,6 +2113,7 @@ def instantiate(view: ClassView, mods: dict[str, Mod], parent: Env | None, path:
             el, lex = m.redeclare
             info = ElemInfo(el, lex, merge(_without_redeclare(m), mod_from_ast(el.mod, SELF,
                                                                                  lex)))
+            cacheable = False
             env.view = view = _with_element(view, name, info, env)
             env.mods = {k: v for k, v in env.mods.items() if k != name}
             env._emod.pop(name, None)
@@ -1941,6 +2125,8 @@ def instantiate(view: ClassView, mods: dict[str, Mod], parent: Env | None, path:
         if cat in ("const", "string"):
             consts.append(name)
             continue
+        if comp.dims or (tref.kind == "scalar" and tref.dims):
+            cacheable = False
         try:
             dims = _dims(info, env)
         except NotConstant as err:
@@ -1961,37 +2147,10 @@ def instantiate(view: ClassView, mods: dict[str, Mod], parent: Env | None, path:
     if cls is None:
         cls = _make_class(view, decls, connector)
         view.classes[key] = cls
-    try:
-        inst = cls()
-    except ModelError as err:
-        raise fail(where or view.scope, pos, str(err)) from None
-    env.inst = inst
-    object.__setattr__(inst, "_mo_env", env)
-    if arrays:
-        object.__setattr__(inst, "_mo_arrays", arrays)
-    # subcomponents (their modifiers may refer to this instance's parameters)
-    for info, tref, dims in children:
-        name = info.comp.name
-        m = env.emod(name)
-        for idx in _indices(dims):
-            cname = _elem_name(name, idx)
-            cm = index_mod(m, idx) if idx else m
-            child = _make_child(tref, cm, env, _join(path, cname), info)
-            _add_child(inst, cname, child, info)
-        if dims:
-            arrays_of = inst.__dict__.get("_mo_arrays")
-            if arrays_of is None:
-                arrays_of = {}
-                object.__setattr__(inst, "_mo_arrays", arrays_of)
-            arrays_of[name] = dims
-    # instance-specific declarations
-    for info, tref, idx, ename in scalars:
-        name = info.comp.name
-        _, static = info.defaults[idx]
-        if static and name not in env.mods:
-            continue
-        inst._symbols[ename].decl = _instance_decl(env, info, tref, idx, connector)
-    return inst
+    plan = (arrays, scalars, children, cls)
+    if cacheable:
+        view.plan = plan
+    return plan
 
 
 def _with_element(view: ClassView, name: str, info: ElemInfo, env: Env) -> ClassView:
@@ -2001,6 +2160,8 @@ def _with_element(view: ClassView, name: str, info: ElemInfo, env: Env) -> Class
     new.elements = dict(view.elements)
     new.elements[name] = info
     new.classes = {}
+    new.plan = None
+    new.validated = False
     return new
 
 
@@ -2024,16 +2185,26 @@ def _make_class(view: ClassView, decls: dict[str, Any], connector: bool) -> type
     body: dict[str, Any] = dict(decls)
     body["__module__"] = "bgmodelica.modelica.generated"
     body["__qualname__"] = view.scope.full_name
-    body["__doc__"] = view.description or f"Modelica {view.kind} {view.scope.full_name}"
+    body["__doc__"] = view.description or None
     if not connector:
         eqs = view.equations
         ieqs = view.initial
 
         def equations(self):
-            return equations_of(self.__dict__["_mo_env"], eqs)
+            env = self.__dict__["_mo_env"]
+            if env.cached is not None and env.cached[0] is not None:
+                out = env.cached[0]
+                env.cached = (None, env.cached[1])
+                return out
+            return equations_of(env, eqs)
 
         def initial_equations(self):
-            return equations_of(self.__dict__["_mo_env"], ieqs, initial=True)
+            env = self.__dict__["_mo_env"]
+            if env.cached is not None and env.cached[1] is not None:
+                out = env.cached[1]
+                env.cached = (env.cached[0], None)
+                return out
+            return equations_of(env, ieqs, initial=True)
 
         body["equations"] = equations
         if ieqs:
@@ -2160,7 +2331,7 @@ def apply_mods(elem: Element, mods: dict[str, Mod], info: ElemInfo, what: str) -
                    f"{name!r} in bgmodelica's mapping (it has: {', '.join(have)})")
 
 
-# -- entry points ------------------------------------------------------------------------------------
+# -- entry points ------------------------------------------------------------------------------
 
 
 def find_class(file: S.FileScope, name: str) -> S.ClassScope:

@@ -181,7 +181,8 @@ SI_TYPES: dict[str, str] = {
     "ElectricCharge": "C", "MagneticFlux": "Wb", "ElectricalTorqueConstant": "N.m/A",
     "Temperature": "K", "ThermodynamicTemperature": "K", "TemperatureDifference": "K",
     "HeatFlowRate": "W", "ThermalConductance": "W/K", "HeatCapacity": "J/K",
-    "MassFlowRate": "kg/s", "VolumeFlowRate": "m3/s", "Efficiency": "1", "DampingCoefficient": "1/s",
+    "MassFlowRate": "kg/s", "VolumeFlowRate": "m3/s", "Efficiency": "1",
+    "DampingCoefficient": "1/s",
     "PerUnit": "1", "Voltage_rms": "V", "Current_rms": "A",
 }
 

@@ -141,15 +141,17 @@ def check_references(model: FlatModel, force: bool = False) -> None:
                                       [-ord(ch) for ch in ",".join(s)])) if sets else []
     comps = sorted({variables[j].component for j in members if variables[j].component},
                    key=lambda c: [variables[j].component for j in members].index(c))
-    what = f"connection set {{{', '.join(chosen)}}}" if chosen else \
+    shown = chosen[:6] + ([f"... ({len(chosen)} connectors)"] if len(chosen) > 6 else [])
+    what = f"connection set {{{', '.join(shown)}}}" if chosen else \
         f"the potential {variables[members[0]].name}"
     more = f" (and {len(floating) - 1} other floating network(s))" if len(floating) > 1 else ""
     names = [variables[j].name for j in members if variables[j].decl.kind == KIND_POTENTIAL]
+    who = (", ".join(comps[:8]) + (", ..." if len(comps) > 8 else "")) if comps \
+        else f"model {model.name}"
     raise UnbalancedModelError(
-        f"{what} has no reference (ground): the potentials of the network of "
-        f"{', '.join(comps[:8])}{', ...' if len(comps) > 8 else ''} enter its equations "
-        f"only as differences, so they are fixed only up to a constant{more}; connect a "
-        "ground (or another reference) to it", missing=names)
+        f"{what} has no reference (ground): the potentials of the network of {who} enter "
+        f"its equations only as differences, so they are fixed only up to a constant{more}; "
+        "connect a ground (or another reference) to it", missing=names)
 
 
 def _connection_sets(model: FlatModel, members: list[int]) -> list[list[str]]:

@@ -63,7 +63,7 @@ class Experiment:
     weights: dict[str, float] | None = None
     name: str = ""
     columns: Sequence[str] | None = None
-    start_time: float = 0.0
+    start_time: float | None = None       # default: fit(start_time=...)
 
 
 def load_table(data: Any, columns: Sequence[str] | None = None,
@@ -197,17 +197,17 @@ class FitResult:
         }
 
     def table(self) -> str:
-        w = max(len(n) for n in self.names)
+        w = max(9, *(len(n) for n in self.names))
         lines = [f"fit of {self.model}: {self.n_data} data, {len(self.names)} parameters, "
                  f"{self.nfev} evaluations, {'converged' if self.success else 'NOT converged'}"
                  f" ({self.message})",
-                 f"  {'parameter':<{w}}  {'estimate':>13}  {'std error':>10}  "
-                 f"{'95% interval':>29}"]
+                 f"  {'parameter':<{w}}  {'estimate':>14}  {'std error':>10}  "
+                 f"{'95% interval':>31}"]
         for n in self.names:
             lo, hi = self.ci95[n]
             unit = self.units.get(n, "")
-            lines.append(f"  {n:<{w}}  {self.estimates[n]:13.6g}  {self.std_errors[n]:10.3g}  "
-                         f"[{lo:13.6g}, {hi:13.6g}] {unit}")
+            lines.append(f"  {n:<{w}}  {self.estimates[n]:14.8g}  {self.std_errors[n]:10.3g}  "
+                         f"[{lo:14.8g}, {hi:14.8g}] {unit}")
         lines.append(f"  weighted rms residual {self.rms:.3g}, condition {self.condition:.3g}, "
                      f"jacobian: {self.jacobian}")
         return "\n".join(lines)
@@ -326,20 +326,25 @@ def fit(model: Any, data: Any, free: Any, *, params: Mapping[str, Any] | None = 
     if jacobian == "forward" and not smooth:
         from .sensitivity import refuse_events
 
-        refuse_events(dae, selection=True if dae.hybrid is None else None)
+        refuse_events(dae, selection=None if dae.hybrid is not None else "dynamic")
     use_fd = jacobian == "fd" or (jacobian == "auto" and not smooth)
     if rank_tol is None:
         rank_tol = 1e-4 if use_fd else 1e-6
     experiments = _experiments(data)
     pnames = [q.name for q in dae.parameters] + [u.name for u in dae.inputs]
     p_default = dae.p_vector(_p_only(dae, dict(params or {}), compiled))
-    defaults = dict(zip(pnames, p_default, strict=True))
+    defaults = dict(zip(pnames, p_default[:len(pnames)], strict=True))   # not discretes
     flat = compiled.reduced.model
     decls = {q.name: q.decl for q in flat.parameters}
     decls.update({u.name: u.decl for u in flat.inputs})
+    if isinstance(free, str):
+        free = [free]
+    given = list(free.keys()) if isinstance(free, Mapping) else list(free)
+    wrt = parameter_indices(dae, given)                   # unknown names: a clear error
+    resolved = {g: pnames[i] for g, i in zip(given, wrt, strict=True)}   # aliases followed
+    free = ({resolved[g]: v for g, v in free.items()} if isinstance(free, Mapping)
+            else [resolved[g] for g in given])
     free_names, x0, lo, hi = _free_spec(free, defaults, decls)
-    wrt = parameter_indices(dae, free_names)
-    free_names = [pnames[i] for i in wrt]                 # aliases resolved
     prepared = [_prepare(compiled, e, k, dict(params or {}), weights, free_names, start_time,
                          use_fd) for k, e in enumerate(experiments)]
     n_data = sum(int(m.sum()) for e in prepared for m in e.masks.values())
@@ -348,7 +353,6 @@ def fit(model: Any, data: Any, free: Any, *, params: Mapping[str, Any] | None = 
         raise FitError(f"fit: {n_data} data points for {n_par} free parameters; need more data")
     scale = np.where(x0 != 0, np.abs(x0), 1.0)
     cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
-    counts = {"sim": 0}
 
     def evaluate(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         key = np.asarray(theta, dtype=float).tobytes()
@@ -360,7 +364,6 @@ def fit(model: Any, data: Any, free: Any, *, params: Mapping[str, Any] | None = 
                                   use_fd)
                 rs.append(r)
                 js.append(J)
-            counts["sim"] += 1
             cache.clear()
             cache[key] = (np.concatenate(rs), np.vstack(js) * scale)    # d r / d theta
         return cache[key]
@@ -440,8 +443,6 @@ def _prepare(compiled: Any, exp: Experiment, k: int, params: dict[str, Any],
                         else f"experiment {k + 1}")
     times, table = load_table(exp.data, exp.columns, name)
     t0 = float(exp.start_time if exp.start_time is not None else start_time)
-    if exp.start_time == 0.0 and start_time != 0.0:
-        t0 = float(start_time)
     if times[0] < t0 - 1e-12:
         raise FitError(f"{name}: data at t = {times[0]:g} s before the start time {t0:g} s")
     columns, col_pos, keep = [], [], []

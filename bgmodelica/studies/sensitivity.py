@@ -121,7 +121,7 @@ def initial_sensitivities(dae: Any, x0: np.ndarray, z0: np.ndarray, p: np.ndarra
                           wrt: list[int]) -> tuple[np.ndarray, np.ndarray]:
     """d(x0)/d(p[wrt]) and d(z0)/d(p[wrt]) of the consistent initial point."""
     nx, nz, ns = dae.x.numel(), dae.z.numel(), len(wrt)
-    key = ("sens-init",)
+    key = ("sens-init", tuple(k for k, _ in dae.fixed))     # start overrides change it
     if key not in dae.cache:
         solved, conditions = _init_partition(dae)
         if not solved and not nz:

@@ -479,3 +479,27 @@ def test_executable_one_line_no_hang(argv, culprit):
     assert done.returncode == 2, done.stderr
     assert len(lines) == 1 and culprit in lines[0], done.stderr
     assert "Traceback" not in done.stderr and done.stdout == ""
+
+
+def test_large_floating_network_is_named():
+    """Above the eager limit the ground search runs once a later check has failed."""
+    from bgmodelica import Component
+    from bgmodelica.errors import UnbalancedModelError
+    from bgmodelica.passes.reference import EAGER_LIMIT
+    from library.electrical import Capacitor, Resistor, SineVoltage
+
+    m = Component(name="floating_ladder")
+    m.add("src", SineVoltage(V=1.0, f=10.0))
+    node = m.src.p
+    n = EAGER_LIMIT // 10 + 1
+    for k in range(1, n + 1):
+        r = m.add(f"R{k}", Resistor(R=1.0))
+        c = m.add(f"C{k}", Capacitor(C=1.0, v=0.0))
+        m.connect(node, r.p)
+        m.connect(r.n, c.p)
+        m.connect(c.n, m.src.n)
+        node = r.n
+    with pytest.raises(UnbalancedModelError) as err:
+        bg.compile(m)
+    assert str(err.value).startswith("connection set {C1.n, ")
+    assert f"... ({n + 1} connectors)}} has no reference (ground)" in str(err.value)

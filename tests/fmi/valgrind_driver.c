@@ -2,7 +2,7 @@
  * Test driver for tests/fmi/test_valgrind.py: dlopens a Co-Simulation FMU binary and runs
  * instantiate / initialize / steps / FMU state / error paths / free several times.
  * Build: cc -g -DFMI_VERSION=2|3 -I<fmu sources> valgrind_driver.c -ldl -o driver
- * Usage: driver <library.so> <token> <vr_param> <vr_output>
+ * Usage: driver <library.so> <token> <vr_param> <vr_output> [<communication step, 0.01>]
  */
 #include <dlfcn.h>
 #include <math.h>
@@ -17,6 +17,7 @@
 #endif
 
 static int n_errors_logged = 0;
+static double dt = 0.01; /* communication step */
 
 #define LOAD(name)                                                             \
     name##TYPE *name = (name##TYPE *)dlsym(lib, #name);                        \
@@ -82,14 +83,14 @@ static int run(void *lib, const char *token, unsigned vr_param, unsigned vr_out)
     CHECK(fmi2SetupExperiment(c, 1, 1e-6, 0.0, 0, 0.0) == fmi2OK);
     CHECK(fmi2EnterInitializationMode(c) == fmi2OK);
     CHECK(fmi2ExitInitializationMode(c) == fmi2OK);
-    for (k = 0; k < 20; k++) CHECK(fmi2DoStep(c, 0.01 * k, 0.01, 1) == fmi2OK);
+    for (k = 0; k < 20; k++) CHECK(fmi2DoStep(c, dt * k, dt, 1) == fmi2OK);
     CHECK(fmi2GetFMUstate(c, &state) == fmi2OK);
     CHECK(fmi2SerializedFMUstateSize(c, state, &size) == fmi2OK);
     blob = (char *)malloc(size);
     CHECK(fmi2SerializeFMUstate(c, state, blob, size) == fmi2OK);
     CHECK(fmi2DeSerializeFMUstate(c, blob, size, &copy) == fmi2OK);
     free(blob);
-    for (k = 20; k < 30; k++) CHECK(fmi2DoStep(c, 0.01 * k, 0.01, 1) == fmi2OK);
+    for (k = 20; k < 30; k++) CHECK(fmi2DoStep(c, dt * k, dt, 1) == fmi2OK);
     CHECK(fmi2GetReal(c, &vr_out, 1, &y) == fmi2OK);
     CHECK(fmi2SetFMUstate(c, copy) == fmi2OK);
     CHECK(fmi2GetDirectionalDerivative(c, &vr_out, 1, &vr_param, 1, &seed, &dd) == fmi2OK);
@@ -145,7 +146,7 @@ static int run(void *lib, const char *token, unsigned vr_param, unsigned vr_out)
     CHECK(fmi3EnterInitializationMode(c, 1, 1e-6, 0.0, 0, 0.0) == fmi3OK);
     CHECK(fmi3ExitInitializationMode(c) == fmi3OK);
     for (k = 0; k < 20; k++)
-        CHECK(fmi3DoStep(c, 0.01 * k, 0.01, 1, &ev, &term, &early, &last) == fmi3OK);
+        CHECK(fmi3DoStep(c, dt * k, dt, 1, &ev, &term, &early, &last) == fmi3OK);
     CHECK(fmi3GetFMUState(c, &state) == fmi3OK);
     CHECK(fmi3SerializedFMUStateSize(c, state, &size) == fmi3OK);
     blob = (fmi3Byte *)malloc(size);
@@ -153,7 +154,7 @@ static int run(void *lib, const char *token, unsigned vr_param, unsigned vr_out)
     CHECK(fmi3DeserializeFMUState(c, blob, size, &copy) == fmi3OK);
     free(blob);
     for (k = 20; k < 30; k++)
-        CHECK(fmi3DoStep(c, 0.01 * k, 0.01, 1, &ev, &term, &early, &last) == fmi3OK);
+        CHECK(fmi3DoStep(c, dt * k, dt, 1, &ev, &term, &early, &last) == fmi3OK);
     CHECK(fmi3GetFloat64(c, &vr_out, 1, &y, 1) == fmi3OK);
     CHECK(fmi3SetFMUState(c, copy) == fmi3OK);
     CHECK(fmi3GetDirectionalDerivative(c, &vr_out, 1, &vr_param, 1, &seed, 1, &dd, 1) ==
@@ -170,10 +171,11 @@ static int run(void *lib, const char *token, unsigned vr_param, unsigned vr_out)
 int main(int argc, char **argv) {
     void *lib;
     int round, rc = 0;
-    if (argc != 5) {
-        fprintf(stderr, "usage: %s lib.so token vr_param vr_output\n", argv[0]);
+    if (argc != 5 && argc != 6) {
+        fprintf(stderr, "usage: %s lib.so token vr_param vr_output [step]\n", argv[0]);
         return 2;
     }
+    if (argc == 6) dt = atof(argv[5]);
     lib = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
     if (!lib) {
         fprintf(stderr, "dlopen: %s\n", dlerror());

@@ -117,3 +117,17 @@ def test_bad_data_refused(dcmotor, tmp_path):
     bad.write_text("t_sec,rotor.w\n0,0\n")
     with pytest.raises(FitError, match="first column must be 'time'"):
         fit(dcmotor, bad, ["emf.k"])
+
+
+def test_model_with_events_fitted_with_labelled_finite_differences():
+    from bgmodelica.studies.sweeps import on_grid
+    from library.examples.hybrid import BouncingBall
+
+    ball = bg.compile(BouncingBall())
+    run = bg.simulate(ball, 1.5, 0.01, params={"e": 0.7}, outputs=["h"], rtol=1e-10,
+                      atol=1e-12)
+    grid = np.round(np.arange(151) * 0.01, 12)                     # as read from a CSV
+    data = {"time": grid, "h": on_grid(run, ["h"], grid)[:, 0]}
+    res = fit(ball, data, {"e": 0.6})
+    assert res.jacobian == "central finite differences"
+    assert res.estimates["e"] == pytest.approx(0.7, rel=1e-4)

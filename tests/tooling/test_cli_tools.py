@@ -28,6 +28,10 @@ def test_info_lists_parameters_states_and_interface(capsys):
     assert main(["info", "library.examples:DCMotor", "--no-compile", "--json"]) == 0
     info = json.loads(capsys.readouterr().out)
     assert "states" not in info and info["parameters"][0]["name"] == "source.V"
+    # a parameter bound to another shows the binding (and, compiled, its value)
+    assert main(["info", "library.bondgraph.paper:DCMotorDrive"]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if "motor.res.R" in x)
+    assert "1 (= motor.R)" in line
 
 
 def test_list_domains_and_components(capsys):

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+import sys
 from pathlib import Path
 
 import pytest
@@ -9,14 +11,22 @@ import pytest
 NOTEBOOK = Path(__file__).resolve().parents[2] / "docs" / "notebooks" / "dc_motor.ipynb"
 
 
-def test_dc_motor_notebook_executes(tmp_path):
+def test_dc_motor_notebook_executes(tmp_path, monkeypatch):
     nbformat = pytest.importorskip("nbformat")
     nbclient = pytest.importorskip("nbclient")
     pytest.importorskip("ipykernel")
     nb = nbformat.read(NOTEBOOK, as_version=4)
     assert not any(c.get("outputs") for c in nb.cells if c.cell_type == "code"), \
         "commit the notebook without outputs"
-    client = nbclient.NotebookClient(nb, timeout=180, kernel_name="python3",
+    # a kernel of this very interpreter, found before any other "python3" kernel spec
+    spec = tmp_path / "jupyter" / "kernels" / "bgmodelica-test"
+    spec.mkdir(parents=True)
+    (spec / "kernel.json").write_text(json.dumps({
+        "argv": [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"],
+        "display_name": "bgmodelica tests", "language": "python"}))
+    monkeypatch.setenv("JUPYTER_PATH", str(tmp_path / "jupyter"))
+    monkeypatch.setenv("MPLBACKEND", "module://matplotlib_inline.backend_inline")
+    client = nbclient.NotebookClient(nb, timeout=180, kernel_name="bgmodelica-test",
                                      resources={"metadata": {"path": str(tmp_path)}})
     client.execute()                      # raises CellExecutionError naming the cell
     outputs = [o for c in nb.cells if c.cell_type == "code" for o in c.outputs]

@@ -441,6 +441,7 @@ bgm_status bgm_hyb_initialize(bgm_inst *c, const char *fn) {
     h->n_recent = h->i_recent = 0;
     for (i = 0; i < BGM_NSAMP; i++) h->samp_set[i] = 0;
     ev_update_tables(c, t0);
+    if (bgm_update_x0(c, fn) != BGM_OK) return BGM_ERROR;
     for (it = 0; it < BGM_EV_MAX_ITER; it++) {
         int same = 1;
         if (ev_step(c, t0, c->v.x)) return ev_failed(c, fn, "event functions", t0);
@@ -449,6 +450,11 @@ bgm_status bgm_hyb_initialize(bgm_inst *c, const char *fn) {
             if (w->vals[k] != h->d[bgm_rel_slot[k]]) same = 0;
         if (same) break;
         for (k = 0; k < BGM_NREL; k++) h->d[bgm_rel_slot[k]] = w->vals[k];
+#if BGM_HAS_INIT
+        /* the consistent initial state for the new relation values */
+        c->v.x0_done = 0;
+        if (bgm_update_x0(c, fn) != BGM_OK) return BGM_ERROR;
+#endif
     }
     if (ev_step(c, t0, c->v.x)) return ev_failed(c, fn, "event functions", t0);
     for (i = 0; i < BGM_NCOND; i++) h->cond_pre[i] = w->cond[i];
@@ -470,6 +476,7 @@ bgm_status bgm_hyb_initialize(bgm_inst *c, const char *fn) {
 
 bgm_status bgm_hyb_enter_event(bgm_inst *c, const char *fn) {
     c->v.h.pending = 0;
+    c->v.h_next = 0.0; /* Co-Simulation: restart the embedded solver after the event */
     if (!c->v.h.initialized) return BGM_OK;
     return ev_begin(c, fn, 0);
 }
@@ -628,6 +635,15 @@ bgm_status bgm_hyb_integrate(bgm_inst *c, const char *fn, double t_end) {
         c->v.h.pending = 0;
         if (ev_begin(c, fn, 0) != BGM_OK || ev_converge(c, fn) != BGM_OK) return BGM_ERROR;
         c->v.h_next = 0.0;
+    }
+    if (BGM_NZ > 0 && t_end > c->v.time) {
+        /* inputs (or parameters) set since the last step moved a relation: an event now */
+        if (ev_ind(c, c->v.time, c->v.x, w->zc))
+            return ev_failed(c, fn, "event indicators", c->v.time);
+        if (ev_changed(c, w->zc)) {
+            if (ev_begin(c, fn, 0) != BGM_OK || ev_converge(c, fn) != BGM_OK) return BGM_ERROR;
+            c->v.h_next = 0.0;
+        }
     }
     while (c->v.time < t_end) {
         double t = c->v.time, t_ev = ev_next_time(c, t), target = t_end;
