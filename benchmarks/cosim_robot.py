@@ -24,10 +24,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from bgmodelica import compile, simulate  # noqa: E402
 from bgmodelica.cosim.master import Master  # noqa: E402
-from bgmodelica.cosim.verify import verify_robot  # noqa: E402
 from bgmodelica.cosim.xcheck import build_container, run_container  # noqa: E402
 from library.robots.robot import RobotPID  # noqa: E402
 from library.robots.subsystems import build_robot_fmus, robot_system  # noqa: E402
+from library.robots.verification import verify_robot  # noqa: E402
 
 
 def best_of(fn, repeat: int) -> float:

@@ -38,6 +38,34 @@ OUTPUTS = ["arm.joint1.q", "arm.joint2.q", "e1", "e2", "motor1.inductor.i",
 SPREAD = {"m1": "+-5%", "m2": "+-5%", "motor1.R": "+-5%", "motor2.R": "+-5%"}
 
 
+def _bare_loop(n: int) -> float:
+    """Seconds for ``n`` plain simulate runs in a fresh process (the machine's parallelism
+    check: no Dask involved)."""
+    import bgmodelica as bg
+    from bgmodelica.loader import load_model
+
+    compiled = bg.compile(load_model("library.robots:RobotPID"))
+    kw = dict(stop_time=10.0, interval=0.01, outputs=OUTPUTS, solver="cvodes")
+    bg.simulate(compiled, **kw)
+    t = time.perf_counter()
+    for i in range(n):
+        _ = bg.simulate(compiled, params={"m1": 3.0 + 1e-3 * i}, **kw).values
+    return time.perf_counter() - t
+
+
+def capacity(workers: int, n: int = 100) -> float:
+    """How much faster ``workers`` bare processes get through their runs than one: what the
+    machine offers right now (other jobs share its cores)."""
+    import multiprocessing as mp
+
+    ctx = mp.get_context("spawn")
+    with ctx.Pool(1) as pool:
+        one = pool.map(_bare_loop, [n])[0]
+    with ctx.Pool(workers) as pool:
+        many = max(pool.map(_bare_loop, [n] * workers))
+    return workers * one / many
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=200)
@@ -155,6 +183,9 @@ def main() -> None:
               f"{a / b:.2f}x (load average {load:.1f})")
     print(f"median speed-up of the alternating pairs: "
           f"{statistics.median(a / b for a, b, _ in pairs):.2f}x")
+    print(f"parallelism check without Dask: {args.workers} bare processes running plain "
+          f"simulate loops get {capacity(args.workers):.2f}x the throughput of one right now "
+          f"(load average {os.getloadavg()[0]:.1f})")
     print(f"runs spread over {len(used)} worker processes; max |serial - distributed| of "
           f"joint 1 = {same:.1e} rad")
     print(f"load average at the end: {os.getloadavg()[0]:.2f}")

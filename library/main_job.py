@@ -108,13 +108,17 @@ def subsystem_fmu_job(name: str, out_dir: str) -> tuple[str, str, float]:
     return name, str(path), time.perf_counter() - t0
 
 
-def verify_job(fmus: dict[str, str]) -> Any:
-    """:func:`bgmodelica.cosim.verify_robot` at :data:`VERIFY_STEP` (Jacobi and
+def verify_job(fmus: dict[str, str], order: str) -> Any:
+    """:func:`library.robots.verification.verify_robot` at :data:`VERIFY_STEP` (Jacobi and
     Gauss-Seidel, with and without extrapolation), Co-Simulation FMUs only; the cross-checks
     run as separate jobs (:func:`cross_check_job`)."""
-    from bgmodelica.cosim import verify_robot
+    try:
+        from library.robots.verification import verify_robot
+    except ImportError:                       # before the robot's study moved to the library
+        from bgmodelica.cosim import verify_robot
 
-    return verify_robot(steps=(VERIFY_STEP,), me_step=None, cross_check_step=None, fmus=fmus)
+    return verify_robot(steps=(VERIFY_STEP,), schemes=((order, False), (order, True)),
+                        me_step=None, cross_check_step=None, fmus=fmus)
 
 
 def cross_check_job(fmus: dict[str, str], order: str) -> dict[str, Any]:
@@ -214,15 +218,17 @@ def _run(outdir: Path, fmu_dir: Path, stages: Stages, pool: ProcessPoolExecutor)
                     f"{setup['ssp']}, {setup['ssp_plain']}")
         lumped = {k: fmus[k] for k in ("Arm", "Motor", "Controller")}
         t_ver = time.perf_counter()
-        ver_job = pool.submit(verify_job, lumped)
-        xcheck_jobs = [pool.submit(cross_check_job, lumped, o)
-                       for o in ("jacobi", "gauss-seidel")]
+        orders = ("jacobi", "gauss-seidel")
+        ver_jobs = [pool.submit(verify_job, lumped, o) for o in orders]
+        xcheck_jobs = [pool.submit(cross_check_job, lumped, o) for o in orders]
         t_mono = time.perf_counter()
         mono_jobs: dict[str, Future] = {
             f"fmi{v}/{name}.fmu": pool.submit(export_fmu_job, name, str(fmu_dir), v)
             for name in MONOLITHIC for v in (2, 3)}
 
-        report = replace(ver_job.result(), cross_checks=[job.result() for job in xcheck_jobs],
+        parts = [job.result() for job in ver_jobs]
+        report = replace(parts[0], rows=[r for p in parts for r in p.rows],
+                         cross_checks=[job.result() for job in xcheck_jobs],
                          fmus=dict(lumped))
         thread.join()                       # its figures use pyplot too (not thread-safe)
         report.plot(outdir / "verify.png")

@@ -158,16 +158,16 @@ class Element:
 
 def _build_child(key: str, template: Element) -> Element:
     """``template.clone()``; an exception of user code names the subcomponent path."""
-    from ..errors import ModelError, UserCodeError
-    from ..validate import nested_user_error, user_error
-
     try:
         return template.clone()
-    except UserCodeError as err:
-        raise nested_user_error(err, key, type(template).__name__) from err.__cause__
-    except ModelError:
-        raise
     except Exception as err:  # noqa: BLE001 -- user code: say where, no traceback
+        from ..errors import ModelError, UserCodeError
+        from ..validate import nested_user_error, user_error
+
+        if isinstance(err, UserCodeError):
+            raise nested_user_error(err, key, type(template).__name__) from err.__cause__
+        if isinstance(err, ModelError):
+            raise
         raise nested_user_error(user_error(err, f"{type(template).__name__}()"), key,
                                 type(template).__name__) from err
 

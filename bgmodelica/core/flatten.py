@@ -160,7 +160,8 @@ class _Flattener:
         inputs: list[FlatVariable] = []
         discretes: list[FlatVariable] = []
         symbols: list[tuple[Symbol, list, int]] = []      # (symbol, target list, index)
-        targets = self.draft.targets if self.draft is not None else {}
+        hybrid = self.draft is not None
+        targets = self.draft.targets if hybrid else {}
         top_connectors = {id(c) for c in self.top._children.values() if isinstance(c, Connector)}
         for elem in self.elements:
             path = self.paths[id(elem)]
@@ -169,11 +170,13 @@ class _Flattener:
                 full = _join(path, sym.name)
                 kind = sym.decl.kind
                 self.full[id(sym)] = full
-                if id(sym) in targets:
-                    self.slot[id(sym)] = len(discretes)
-                    symbols.append((sym, discretes, len(discretes)))
-                    discretes.append(FlatVariable(full, None, sym.decl, owner))
-                elif kind == KIND_PARAMETER:
+                if hybrid:
+                    if id(sym) in targets:
+                        self.slot[id(sym)] = len(discretes)
+                        symbols.append((sym, discretes, len(discretes)))
+                        discretes.append(FlatVariable(full, None, sym.decl, owner))
+                        continue
+                if kind == KIND_PARAMETER:
                     symbols.append((sym, parameters, len(parameters)))
                     parameters.append(FlatVariable(full, None, sym.decl, owner))
                 elif kind == KIND_INPUT and (elem is self.top or id(elem) in top_connectors):

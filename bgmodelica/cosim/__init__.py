@@ -1,5 +1,5 @@
 """Co-simulation of FMUs: SSP set-ups, a fixed-step master, checks, a cross-check against
-``fmucontainer`` and the verification of the split robot against the monolithic model.
+``fmucontainer`` and the verification of a co-simulation against the monolithic model.
 
 Modules:
 
@@ -13,7 +13,8 @@ Modules:
 - :mod:`.master`: :class:`Master` / :func:`cosimulate` -- fixed macro step, Jacobi or
   Gauss-Seidel, optional linear extrapolation, feedthrough propagation;
 - :mod:`.xcheck`: :func:`cross_check` against an ``fmucontainer`` container FMU;
-- :mod:`.verify`: :func:`verify_robot` -> :class:`VerifyReport` (the paper's PID robot);
+- :mod:`.verify`: :func:`verify_model` -> :class:`VerificationReport` (any model against the
+  co-simulation of its parts; the robot's study is :mod:`library.robots.verification`);
 - :mod:`.cli`: the ``cosim`` and ``verify`` subcommands (:func:`~.cli.register`).
 
 Errors are :class:`bgmodelica.errors.ModelError` subclasses (:mod:`.errors`).
@@ -46,7 +47,7 @@ from .ssp import (
     system_from_fmus,
     write_ssp,
 )
-from .verify import VerifyReport, verify_robot
+from .verify import VerificationReport, verify_model
 from .wrap import FlowInput, FlowOutput, PotentialInput, PotentialOutput, add_signal, expose
 
 __all__ = [
@@ -55,7 +56,7 @@ __all__ = [
     "InvalidParameterError", "SafeZip", "SetupError", "SspFormatError",
     "UnconnectedInputError", "UnknownConnectorError", "UnsafeArchiveError",
     "Master", "cosimulate", "SspComponent", "SspConnection", "SspConnector",
-    "SystemStructure", "read_ssp", "system_from_fmus", "write_ssp", "VerifyReport",
-    "verify_robot", "FlowInput", "FlowOutput", "PotentialInput", "PotentialOutput",
+    "SystemStructure", "read_ssp", "system_from_fmus", "write_ssp", "VerificationReport",
+    "verify_model", "FlowInput", "FlowOutput", "PotentialInput", "PotentialOutput",
     "add_signal", "expose",
 ]

@@ -5,11 +5,14 @@
     co-simulate an SSP set-up with the fixed-step master (``--extrapolation``,
     ``--interface cs|me|auto``, ``--no-propagate``, ``--set ELEMENT.NAME=VALUE``,
     ``--record ELEMENT.VAR``, ``--plot out.png``).
-``bgmodelica verify [--steps 10e-3,5e-3,2e-3,1e-3,5e-4] [--json] [--plot out.png]``
-    the paper's PID robot, monolithic vs co-simulated: error table per joint, observed
-    convergence order, both orders with and without extrapolation, wall time per simulated
-    second, cross-check with fmucontainer (``--stop-time``, ``--coupling lumped|plain``,
-    ``--no-me``, ``--no-cross-check``, ``--fmu-dir DIR`` to keep the FMUs).
+``bgmodelica verify MODEL SSP [--step 4e-3,2e-3,1e-3] [--stop-time T] [--tolerance TOL] [--json]``
+    any model, monolithic vs the co-simulation of its parts (variables matched by name,
+    :func:`~.verify.verify_model`): error table per variable, observed convergence order,
+    both orders with and without extrapolation (``--order``, ``--extrapolation``), wall time
+    per simulated second; exit status 1 when an error exceeds ``--tolerance`` (``--vars``,
+    ``--set``, ``--record``, ``--interface``, ``--static-states``). The paper's robot with its
+    split check, Model Exchange runs and fmucontainer cross-check is
+    :func:`library.robots.verification.verify_robot`.
 
 Bad input (an unsafe or broken SSP/FMU, an inconsistent set-up, non-finite or absurd times
 and steps, an output folder that does not exist) ends in one line on stderr and exit status
@@ -135,37 +138,52 @@ def _steps(text: str) -> list[float]:
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
-    """``bgmodelica verify``: monolithic robot vs co-simulation."""
-    from .verify import verify_robot
+    """``bgmodelica verify MODEL SSP``: monolithic model vs co-simulation of its parts;
+    exit status 1 when ``--tolerance`` is exceeded."""
+    from ..loader import load_model
+    from .ssp import read_ssp
+    from .verify import SCHEMES, verify_model
 
     def progress(msg: str) -> None:
         if not args.quiet:
             sys.stderr.write(f"  {msg}\n")
             sys.stderr.flush()
 
-    work = Path(args.fmu_dir) if args.fmu_dir else None
-    if work is not None and work.exists() and not work.is_dir():
-        raise CosimError(f"--fmu-dir {work} exists and is not a folder")
-    plot = _writable(args.plot, "plot")
-    report = verify_robot(_steps(args.steps), args.stop_time, coupling=args.coupling,
-                          me_step=None if args.no_me else 1e-3,
-                          cross_check_step=None if args.no_cross_check else 1e-3,
-                          work_dir=work, progress=progress)
+    steps = _steps(",".join(args.step)) if args.step else None
+    if args.tolerance is not None and not (math.isfinite(args.tolerance)
+                                           and args.tolerance >= 0):
+        raise ParameterError(f"--tolerance must be a finite number >= 0, got {args.tolerance}")
+    schemes = [(o, ex) for o, ex in SCHEMES
+               if args.order in ("all", o) and args.extrapolation in (None, ex)]
+    from ..cli import _model_kwargs
+
+    model = load_model(args.model, **_model_kwargs(args.arg))
+    system = read_ssp(args.ssp)
+    vars_ = [v for item in args.vars or () for v in item.split(",") if v.strip()]
+    report = verify_model(model, system, steps, args.stop_time, variables=vars_ or None,
+                          schemes=schemes, interface=args.interface,
+                          parameters=_sets(args.set), record=args.record or (),
+                          simulate_options={"dynamic": False} if args.static_states else None,
+                          progress=progress)
+    failed = args.tolerance is not None and bool(report.failures(args.tolerance))
     if args.json:
-        print(json.dumps(report.to_dict(), indent=2))
+        data = report.to_dict()
+        if args.tolerance is not None:
+            data["tolerance"] = {"value": args.tolerance, "passed": not failed,
+                                 "verdict": report.verdict(args.tolerance)}
+        print(json.dumps(data, indent=2))
+        if failed:
+            print(report.verdict(args.tolerance), file=sys.stderr)
     else:
         print(report.to_text())
-    if plot is not None:
-        _write_atomically(plot, report.plot, "plot")
-        if not args.json:
-            print(f"plot -> {plot}")
-    return 0
+        if args.tolerance is not None:
+            print(report.verdict(args.tolerance))
+    return 1 if failed else 0
 
 
 def register(sub: Any, model_args: Any = None) -> None:
     """Add the ``cosim`` and ``verify`` subcommands to the ``bgmodelica`` parser (``sub``:
-    its subparsers; ``model_args`` is unused: these commands take SSP files, not models)."""
-    del model_args
+    its subparsers; ``model_args(parser)`` adds the MODEL argument and ``--arg``)."""
     cos = sub.add_parser("cosim", help="co-simulate an SSP set-up of FMUs (fixed-step master)")
     cos.add_argument("ssp", help="the .ssp file (SystemStructure.ssd + FMUs in resources/)")
     cos.add_argument("--step", type=float, default=None,
@@ -191,18 +209,38 @@ def register(sub: Any, model_args: Any = None) -> None:
     cos.add_argument("--plot-vars", nargs="+", help="variables to plot")
     cos.set_defaults(func=cmd_cosim)
 
-    ver = sub.add_parser("verify", help="PID robot: monolithic vs co-simulation (errors, "
-                                        "convergence order, timing, fmucontainer check)")
-    ver.add_argument("--steps", default="10e-3,5e-3,2e-3,1e-3,5e-4",
-                     help="comma-separated macro steps [s]")
-    ver.add_argument("--stop-time", type=float, default=10.0, help="[s] (default 10)")
-    ver.add_argument("--coupling", choices=["lumped", "plain"], default="lumped",
-                     help="subsystem split (see library.robots.subsystems)")
+    ver = sub.add_parser("verify", help="a model vs the co-simulation of its parts (SSP): "
+                                        "errors, convergence order, --tolerance check")
+    if model_args is not None:
+        model_args(ver)
+    else:
+        ver.add_argument("model", help="path/file.py:Name or package.module:Name")
+        ver.add_argument("--arg", action="append", default=[], metavar="NAME=VALUE",
+                         help="argument for a parameterized model constructor")
+    ver.add_argument("ssp", help="the .ssp set-up of the model's parts")
+    ver.add_argument("--step", "--steps", action="append", default=[],
+                     help="macro steps [s], comma-separated or repeated (default: 4, 2 and 1 "
+                          "times the SSP's step size)")
+    ver.add_argument("--stop-time", type=float, default=None,
+                     help="[s] (default: the SSP DefaultExperiment, else 1)")
+    ver.add_argument("--tolerance", type=float, default=None,
+                     help="largest allowed |cosim - model| of every compared variable in every "
+                          "run; exceeded: exit status 1")
+    ver.add_argument("--vars", action="append", metavar="ELEMENT.VAR",
+                     help="co-simulation variables to compare (comma-separated or repeated; "
+                          "default: every output whose name matches a model variable)")
+    ver.add_argument("--order", choices=["jacobi", "gauss-seidel", "all"], default="all",
+                     help="coupling orders to run (default both)")
+    ver.add_argument("--extrapolation", action=argparse.BooleanOptionalAction, default=None,
+                     help="only with (or without) input extrapolation (default both)")
+    ver.add_argument("--interface", choices=["cs", "me"], default="cs",
+                     help="Co-Simulation FMUs or Model Exchange (master's integrator)")
+    ver.add_argument("--set", action="append", default=[], metavar="ELEMENT.NAME=VALUE",
+                     help="override a parameter of an element")
+    ver.add_argument("--record", nargs="+", metavar="ELEMENT.VAR",
+                     help="also record and compare these variables (locals, states)")
+    ver.add_argument("--static-states", action="store_true",
+                     help="reference without dynamic state selection (dynamic=False)")
     ver.add_argument("--json", action="store_true", help="machine-readable report")
-    ver.add_argument("--plot", help="PNG: error vs macro step per joint")
-    ver.add_argument("--no-me", action="store_true", help="skip the Model Exchange runs")
-    ver.add_argument("--no-cross-check", action="store_true",
-                     help="skip the fmucontainer cross-check")
-    ver.add_argument("--fmu-dir", help="build (and keep) the FMUs here")
     ver.add_argument("--quiet", action="store_true", help="no progress on stderr")
     ver.set_defaults(func=cmd_verify)

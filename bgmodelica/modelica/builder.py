@@ -684,15 +684,12 @@ def _lexical_value(found: Any, ctx: Ctx, node: Any) -> Any:
     raise fail(ctx.lex, node, f"{node.dotted} names a class, not a value")
 
 
-_STATIC: dict[int, Env] = {}
-
-
 def static_env(scope: S.ClassScope) -> Env:
     """An environment without instance for reading constants of a package or class."""
-    env = _STATIC.get(id(scope))
-    if env is None or env.view.scope is not scope:
+    env = scope._static
+    if env is None:
         env = Env(class_view(scope), {}, None, scope.full_name)
-        _STATIC[id(scope)] = env
+        scope._static = env
     return env
 
 
@@ -2238,6 +2235,10 @@ def _make_msl(msl: S.MslClass, m: Mod | None, path: str, info: ElemInfo) -> Elem
     entry = msl.entry
     cls = entry.load()
     sub = dict(m.sub) if m is not None else {}
+    for low, high in entry.negated.items():         # MSL: yMin = -yMax unless given
+        if low not in sub and high in sub and sub[high].has_binding:
+            sub[low] = Mod(const=_neg(sub[high].value(False), Ctx(None, info.lex, {}, False),
+                                      info.comp))
     kwargs: dict[str, Any] = {}
     rest: dict[str, Mod] = {}
     for name, sm in sub.items():

@@ -177,6 +177,9 @@ class _Writer:
             return self.leaf(e.sym, base, what)
         if isinstance(e, Op):
             op, args = e.op, e.args
+            table = _table_of(e)
+            if table is not None:
+                return self.table(table, base)
             if op in _INFIX:
                 return (f"({self.expr(args[0], base, what)} {_INFIX[op]} "
                         f"{self.expr(args[1], base, what)})")
@@ -205,6 +208,40 @@ class _Writer:
                 "expression; only equations written with bgmodelica expressions can be "
                 "exported")
         raise ModelicaExportError(f"{self.tree.where(base)}: cannot write {e!r} in Modelica")
+
+    def table(self, table: TimeTable, base: Element) -> str:
+        """A time table as an if-expression of time (its breakpoints stay time events)."""
+        if table.extrapolation == "periodic":
+            raise ModelicaExportError(
+                f"{self.tree.where(base)} ({type(base).__name__}): a time table with "
+                "periodic extrapolation cannot be written as Modelica yet")
+        times = [float(t) for t in table.times]
+        values = [float(v) for v in table.values]
+        linear = table.interpolation == "linear"
+        n = len(times)
+
+        def segment(a: int, b: int) -> str:
+            dt = times[b] - times[a]
+            if not linear or dt <= 0.0:
+                return number(values[a] if not linear else values[b])
+            c1 = (values[b] - values[a]) / dt
+            c0 = values[a] - c1 * times[a]
+            return f"({number(c0)} + ({number(c1)} * time))" if c1 != 0.0 else number(c0)
+
+        pieces: list[tuple[float, str]] = []
+        if n > 1 and table.extrapolation == "linear" and linear:
+            pieces.append((times[0], segment(0, 1)))
+        else:
+            pieces.append((times[0], number(values[0])))
+        for i in range(1, n):
+            if times[i] > times[i - 1]:
+                pieces.append((times[i], segment(i - 1, i) if linear else number(values[i - 1])))
+        if n > 1 and table.extrapolation == "linear" and linear:
+            last = segment(n - 2, n - 1)
+        else:
+            last = number(values[-1])
+        out = "(if " + " elseif ".join(f"(time < {number(t)}) then {v}" for t, v in pieces)
+        return out + f" else {last})"
 
     # -- equations ---------------------------------------------------------------------------
     def equation(self, eq: Any, base: Element, indent: str) -> list[str]:
@@ -392,6 +429,7 @@ class Exporter:
         self.lifted: dict[int, dict[str, str]] = {}     # id(element) -> name -> declaration
         self._lift_names: dict[int, dict[str, str]] = {}
         self.writer.lift = self.lift
+        self.signals: dict[str, str] = {}
 
     # -- modifications -----------------------------------------------------------------------
     def _place_modifications(self) -> None:
@@ -462,6 +500,18 @@ class Exporter:
         self.order.append((kind, name, f"{head}\n{body}  end {name};\n"))
         return name
 
+    def signal_class(self, kind: str) -> str:
+        """``connector RealInput = input Real`` (or RealOutput), declared once: signals of
+        components must be connectors to be connected in Modelica."""
+        name = self.signals.get(kind)
+        if name is None:
+            direction = "input" if kind == KIND_INPUT else "output"
+            name = self._fresh("RealInput" if kind == KIND_INPUT else "RealOutput")
+            self.signals[kind] = name
+            self.order.insert(0, ("connector", name,
+                                  f"  connector {name} = {direction} Real;\n"))
+        return name
+
     def _fresh(self, base: str) -> str:
         base = re.sub(r"\W", "_", base) or "C"
         if not _IDENT.match(base):
@@ -483,7 +533,10 @@ class Exporter:
             decl = sym.decl if top else _class_decl(elem, name, sym)
             prefix, base_type = _type_and_prefix(decl, connector)
             attrs = _attr_text(decl, base_type, None, writer, elem)
-            text = f"{ind}{prefix}{base_type} {ident(name)}"
+            type_name = base_type
+            if not connector and decl.kind in (KIND_INPUT, KIND_OUTPUT) and base_type == "Real":
+                type_name, prefix = self.signal_class(decl.kind), ""     # connect()-able
+            text = f"{ind}{prefix}{type_name} {ident(name)}"
             if attrs:
                 text += f"({', '.join(attrs)})"
             if decl.kind == KIND_PARAMETER:
@@ -587,6 +640,20 @@ def _doc(elem: Element) -> str:
         return ""
     first = doc.strip().split("\n\n")[0]
     return " ".join(first.split())
+
+
+def _table_of(e: Op) -> TimeTable | None:
+    """The table of ``table + table.c1*time`` (what :func:`bgmodelica.time_table` builds)."""
+    if e.op != "+" or len(e.args) != 2:
+        return None
+    a, b = e.args
+    if not (isinstance(a, Leaf) and isinstance(a.sym, TimeTable)):
+        return None
+    if isinstance(b, Op) and b.op == "*" and isinstance(b.args[0], Leaf) \
+            and b.args[0].sym is a.sym.c1 and isinstance(b.args[1], Leaf) \
+            and b.args[1].sym is TIME:
+        return a.sym
+    return None
 
 
 def _leaves(e: Any, out: list) -> None:

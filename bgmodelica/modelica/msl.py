@@ -44,6 +44,8 @@ class Entry:
     ctor: dict[str, str] = field(default_factory=dict)
     ignore: dict[str, Any] = field(default_factory=dict)
     enum_ctor: dict[str, str] = field(default_factory=dict)
+    #: MSL parameters whose default is minus another one (``yMin = -yMax``)
+    negated: dict[str, str] = field(default_factory=dict)
 
     def load(self) -> type:
         try:
@@ -146,6 +148,7 @@ MAPPING: dict[str, Entry] = {
     "Modelica.Blocks.Continuous.LimPID":
         Entry(_B, "LimPID", rename={"yMax": "y_max", "yMin": "y_min"},
               ctor={"xi_start": "xi_start"}, enum_ctor={"controllerType": "controller_type"},
+              negated={"yMin": "yMax"},
               ignore={"initType": None, "xd_start": 0.0, "y_start": 0.0,
                       "withFeedForward": False, "kFF": 1.0, "limitsAtInit": True,
                       "homotopyType": None, "strict": False}),
@@ -161,7 +164,7 @@ MAPPING: dict[str, Entry] = {
     "Modelica.Blocks.Sources.Ramp":
         Entry(_B, "Ramp", rename={"startTime": "start_time"}),
     "Modelica.Blocks.Nonlinear.Limiter":
-        Entry(_B, "Limiter", rename={"uMax": "u_max", "uMin": "u_min"},
+        Entry(_B, "Limiter", rename={"uMax": "u_max", "uMin": "u_min"}, negated={"uMin": "uMax"},
               ignore={"strict": False, "homotopyType": None}),
 }
 

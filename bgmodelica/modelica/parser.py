@@ -607,7 +607,7 @@ def _terminal_text(name: str) -> str:
     return repr(name.lower())
 
 
-_CACHE: dict[str, tuple[tuple[float, int], A.StoredDefinition]] = {}
+_CACHE: dict[str, tuple[tuple, A.StoredDefinition]] = {}
 
 
 def parse_file(path: str | os.PathLike) -> A.StoredDefinition:
@@ -622,7 +622,7 @@ def parse_file(path: str | os.PathLike) -> A.StoredDefinition:
         raise ModelicaError(f"Modelica file {p} is not UTF-8 text ({err.reason} at byte "
                             f"{err.start})") from None
     key = str(p.resolve())
-    stamp = (st.st_mtime, st.st_size)
+    stamp = (st.st_mtime_ns, st.st_size, hash(text))
     hit = _CACHE.get(key)
     if hit is not None and hit[0] == stamp:
         return hit[1]

@@ -118,7 +118,7 @@ class ClassScope:
     """A class definition in its lexical context."""
 
     __slots__ = ("cdef", "parent", "file", "_classes", "_consts", "_imports", "_cache",
-                 "__weakref__", "_view")
+                 "__weakref__", "_view", "_static")
 
     def __init__(self, cdef: A.ClassDef, parent: ClassScope | None, file: FileScope) -> None:
         self.cdef = cdef
@@ -129,6 +129,7 @@ class ClassScope:
         self._imports: list[A.Import] = []
         self._cache: dict[str, Any] = {}
         self._view = None
+        self._static = None
         for el in cdef.elements:
             if isinstance(el, A.ClassDef):
                 self._classes[el.name] = el

@@ -424,21 +424,24 @@ def test_cli_output_name_from_the_ssd_stays_here(main, tanks, tmp_path, capsys):
 
 @pytest.mark.parametrize("args, kind, message", [
     (["--steps", "nan"], "ParameterError", "finite positive macro steps required"),
-    (["--steps", "1e-3,-1"], "ParameterError", "finite positive macro steps required"),
+    (["--step", "1e-3,-1"], "ParameterError", "finite positive macro steps required"),
     (["--stop-time", "inf"], "InvalidExperimentError", "stop time inf is not finite"),
     (["--stop-time", "1e12", "--steps", "1e-3"], "InvalidExperimentError",
      "needs 1e+15 macro steps"),
     (["--stop-time", "1", "--steps", "3e-3"], "InvalidExperimentError", "not a multiple"),
-    (["--plot", "missing/v.png"], "CosimError", "does not exist"),
+    (["--tolerance", "nan"], "ParameterError", "--tolerance must be a finite number"),
 ])
-def test_cli_verify_bad_options(main, monkeypatch, capsys, args, kind, message):
-    """Refused before any FMU is built or anything simulated."""
-    import library.robots.subsystems as sub
+def test_cli_verify_bad_options(main, tanks, monkeypatch, tmp_path, capsys, args, kind,
+                                message):
+    """``verify MODEL SSP``: refused before anything is compiled or simulated."""
+    import bgmodelica
 
-    def no_build(*a, **k):
-        raise AssertionError("the FMUs must not be built for bad options")
-    monkeypatch.setattr(sub, "build_robot_fmus", no_build)
-    assert main(["verify", "--no-me", "--no-cross-check", "--quiet", *args]) == 2
+    def no_compile(*a, **k):
+        raise AssertionError("nothing must be compiled for bad options")
+    monkeypatch.setattr(bgmodelica, "compile", no_compile)
+    path = write_ssp(tanks, tmp_path / "t.ssp")
+    assert main(["verify", "library.examples.hybrid:PWMMotor", str(path), "--quiet",
+                 *args]) == 2
     assert message in one_error_line(capsys, kind)
 
 

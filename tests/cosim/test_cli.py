@@ -1,5 +1,5 @@
-"""The ``cosim`` and ``verify`` subcommands (registered through ``bgmodelica.cli``) and the
-``verify_robot`` API."""
+"""The ``cosim`` and ``verify`` subcommands (registered through ``bgmodelica.cli``), the
+generic ``verify`` on the robot and the robot's ``verify_robot`` study."""
 
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ import pytest
 from bgmodelica import cli
 from bgmodelica.cosim.cli import register
 from bgmodelica.cosim.ssp import SspConnection, write_ssp
-from bgmodelica.cosim.verify import VerifyReport, verify_robot
 from library.robots.subsystems import robot_connections, robot_system
+from library.robots.verification import VerifyReport, verify_robot
 
 
 @pytest.fixture
@@ -51,17 +51,37 @@ def test_cosim_command_reports_bad_setups(main, robot_fmus, tmp_path, capsys):
     assert "does not exist" in capsys.readouterr().err
 
 
-def test_verify_command(main, robot_fmus, monkeypatch, tmp_path, capsys):
-    import library.robots.subsystems as sub
-
-    monkeypatch.setattr(sub, "build_robot_fmus", lambda *a, **k: dict(robot_fmus))
-    rc = main(["verify", "--steps", "2e-3,1e-3", "--stop-time", "0.3", "--no-me",
-               "--no-cross-check", "--json", "--quiet", "--plot", str(tmp_path / "v.png")])
+def test_verify_command(main, robot_setup, capsys):
+    """The generic ``verify MODEL SSP`` on the robot's set-up (joint angles by name)."""
+    rc = main(["verify", "library.robots.robot:RobotPID", str(robot_setup["ssp"]),
+               "--step", "2e-3,1e-3", "--stop-time", "0.3", "--vars", "arm.q1,arm.q2",
+               "--static-states", "--json", "--quiet"])
     assert rc == 0
     data = json.loads(capsys.readouterr().out)
     assert data["steps"] == [2e-3, 1e-3] and len(data["rows"]) == 8
+    assert data["variables"] == {"arm.q1": "arm.q1", "arm.q2": "arm.q2"}
     assert {(r["order"], r["extrapolation"]) for r in data["rows"]} == {
         ("jacobi", False), ("jacobi", True), ("gauss-seidel", False), ("gauss-seidel", True)}
+    assert all(e < 1e-3 for r in data["rows"] if r["step"] == 1e-3
+               for e in r["errors"].values())
+    rc = main(["verify", "library.robots.robot:RobotPID", str(robot_setup["ssp"]),
+               "--step", "1e-3", "--stop-time", "0.3", "--vars", "arm.q1", "--vars", "arm.q2",
+               "--static-states", "--quiet", "--tolerance", "1e-3"])
+    assert rc == 0
+    assert "verify PASSED" in capsys.readouterr().out
+
+
+def test_robot_verification_module(robot_fmus, monkeypatch, tmp_path, capsys):
+    """``python -m library.robots.verification``: the robot's study (old ``verify``)."""
+    import library.robots.subsystems as sub
+    from library.robots.verification import main as robot_main
+
+    monkeypatch.setattr(sub, "build_robot_fmus", lambda *a, **k: dict(robot_fmus))
+    assert robot_main(["--steps", "2e-3,1e-3", "--stop-time", "0.3", "--no-me",
+                       "--no-cross-check", "--json", "--quiet", "--plot",
+                       str(tmp_path / "v.png")]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert len(data["rows"]) == 8
     assert all(r["error_q1"] < 1e-3 and r["error_q2"] < 1e-3 for r in data["rows"]
                if r["step"] == 1e-3)
     assert (tmp_path / "v.png").stat().st_size > 1000

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import importlib
 import inspect
+import pkgutil
 
 import numpy as np
 import pytest
@@ -14,15 +15,18 @@ from bgmodelica import Component
 from bgmodelica.modelica import export_modelica, load_modelica, load_modelica_text
 
 #: stop times short enough for the suite, long enough to pass events and transients
-STOP = {"PWMMotor": 0.002, "StickSlip": 3.0, "HalfWaveRectifier": 0.05, "Pendulum": 0.5,
-        "PendulumPreferXY": 0.5, "PendulumWall": 0.6, "DoublePendulum": 0.1,
+STOP = {"PWMMotor": 0.002, "PWMDriver": 0.002, "StickSlip": 3.0, "HalfWaveRectifier": 0.05,
+        "Pendulum": 0.5, "PendulumPreferXY": 0.5, "PendulumWall": 0.6, "DoublePendulum": 0.1,
         "PIDSpeedControl": 1.5}
 
 
 def _examples():
+    """Every Component class defined in a module of ``library.examples``."""
+    import library.examples as examples
+
     out = []
-    for mod_name in ("circuits", "mechanics", "motors", "constrained", "hybrid"):
-        mod = importlib.import_module(f"library.examples.{mod_name}")
+    for info in sorted(pkgutil.iter_modules(examples.__path__), key=lambda m: m.name):
+        mod = importlib.import_module(f"library.examples.{info.name}")
         for name, cls in vars(mod).items():
             if inspect.isclass(cls) and issubclass(cls, Component) \
                     and cls.__module__ == mod.__name__:

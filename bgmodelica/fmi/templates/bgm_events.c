@@ -197,11 +197,13 @@ static double ev_next_time(bgm_inst *c, double t) {
     int i;
     for (i = 0; i < BGM_NSAMP; i++) {
         double start = h->samp[2 * i], interval = h->samp[2 * i + 1];
-        ts = next_sample(start, interval, t);
+        /* an instant within rounding of t that was not handled yet is due now (a master's
+           communication point k*H may differ by an ulp from the accumulated time) */
+        ts = next_sample(start, interval, t - 1e-12 * dmax(dmax(1.0, fabs(t)), interval));
         /* an instant within rounding of the one just handled is that one */
         if (h->samp_set[i] && instant_index(start, interval, ts) == h->samp_last[i])
             ts = next_sample(start, interval, ts);
-        best = dmin(best, ts);
+        best = dmin(best, dmax(ts, t));
     }
     for (i = 0; i < BGM_NTAB; i++) {
         table_coefficients(i, t, &c0, &c1, &ts);
