@@ -287,9 +287,9 @@ def test_unsafe_sources_in_the_ssd(tmp_path, robot_ssp):
         return make_zip(tmp_path / name, members)
 
     for source, reason in (("../evil.fmu", "a '..' component"),
-                           ("/tmp/evil.fmu", "an absolute path"),
+                           ("/abs/evil.fmu", "an absolute path"),
                            ("C:/evil.fmu", "a drive letter"),
-                           ("file:///tmp/evil.fmu", "':'")):
+                           ("file:///abs/evil.fmu", "':'")):
         path = ssp(text.replace('source="resources/Arm.fmu"', f'source="{source}"', 1),
                    "src.ssp")
         with pytest.raises(UnsafeArchiveError, match=reason) as err:

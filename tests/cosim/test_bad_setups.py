@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import copy
 import math
+import tempfile
 import zipfile
 from pathlib import Path
 
@@ -345,18 +346,22 @@ def one_error_line(capsys, kind: str) -> str:
     return lines[0]
 
 
+#: an absolute member name: must never be written
+ABS_TARGET = Path(tempfile.gettempdir()) / "bgm_evil_abs.txt"
+
+
 def test_cli_malicious_ssp(main, tmp_path, capsys):
     evil = tmp_path / "evil.ssp"
     with zipfile.ZipFile(evil, "w") as zf:
         zf.writestr("SystemStructure.ssd", "<x/>")
         zf.writestr("../../evil.txt", "pwned")
-        zf.writestr("/tmp/bgm_evil_abs.txt", "pwned")
+        zf.writestr(str(ABS_TARGET), "pwned")
     before = {p for p in tmp_path.parent.rglob("*")}
     assert main(["cosim", str(evil), "-o", str(tmp_path / "out.csv")]) == 2
     line = one_error_line(capsys, "UnsafeArchiveError")
     assert "'../../evil.txt'" in line and str(evil) in line
     assert {p for p in tmp_path.parent.rglob("*")} == before
-    assert not Path("/tmp/bgm_evil_abs.txt").exists()
+    assert not ABS_TARGET.exists()
 
 
 def test_cli_malicious_nested_fmu_and_sources(main, tanks, tmp_path, capsys):
