@@ -286,3 +286,40 @@ def singular_linear_block(residuals: list, unknowns: list, tries: int = 2) -> bo
         if not np.all(np.isfinite(m)) or np.linalg.matrix_rank(m) == n:
             return False
     return True
+
+
+_UNSAFE_UNARY = tuple(getattr(ca, n) for n in ("OP_SQRT", "OP_LOG", "OP_ASIN", "OP_ACOS",
+                                                 "OP_TAN", "OP_ATANH", "OP_ACOSH", "OP_INV",
+                                                 "OP_ERFINV", "OP_LOG1P") if hasattr(ca, n))
+_UNSAFE_ANY = tuple(getattr(ca, n) for n in ("OP_POW", "OP_CONSTPOW", "OP_FMOD")
+                    if hasattr(ca, n))
+
+
+def unsafe_outputs(f: ca.Function, varying: tuple[int, ...]) -> list[int]:
+    """Output entries of ``f`` (one dense output) that can turn non-finite for finite
+    inputs: they apply a division, root, logarithm, power, ... to something that depends on
+    the ``varying`` inputs (time, states, algebraic variables). The others are finite
+    whenever those inputs are, so a result check need not evaluate them."""
+    dep: dict[int, bool] = {}
+    bad: dict[int, bool] = {}
+    out: list[int] = []
+    for k in range(f.n_instructions()):
+        op = f.instruction_id(k)
+        ins, outs = f.instruction_input(k), f.instruction_output(k)
+        if op == ca.OP_INPUT:
+            dep[outs[0]], bad[outs[0]] = ins[0] in varying, False
+        elif op == ca.OP_OUTPUT:
+            if bad.get(ins[0], False):
+                out.append(outs[1])
+        elif op == ca.OP_CONST or not outs:
+            if outs:
+                dep[outs[0]], bad[outs[0]] = False, False
+        else:
+            d = any(dep.get(i, False) for i in ins)
+            b = any(bad.get(i, False) for i in ins)
+            if op == ca.OP_DIV:
+                b = b or dep.get(ins[1], False)
+            elif op in _UNSAFE_UNARY or op in _UNSAFE_ANY:
+                b = b or d
+            dep[outs[0]], bad[outs[0]] = d, b
+    return sorted(set(out))

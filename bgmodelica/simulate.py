@@ -14,8 +14,9 @@ from .backends.casadi_init import initialize
 from .compiler import CompiledModel, compile
 from .core.component import Component
 from .core.units import with_units
-from .diagnose import check_initial_point, check_result
+from .diagnose import check_initial_point, check_result, unsafe_outputs
 from .errors import ParameterError, SimulationError
+from .events.fast import Fast
 from .result import Result
 from .validate import check_run_options, check_values, output_grid
 
@@ -152,7 +153,8 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
     kept = set(names)
     aliases = {a: rep for a, rep in flat.aliases.items() if rep[0] in kept}
     result = Result(grid[:n_ok], values, names, aliases, params_out, units, meta)
-    check_result(result, dae, p)
+    if not _finite_run(dae, obs_idx, grid[:n_ok], xs, zs, p):
+        check_result(result, dae, p)            # names the variable and time
     if failure is not None:
         t_reached = float(grid[n_ok - 1]) if n_ok else start_time
         hint = next((h for key, h in _HINTS.items() if key in failure), "see the solver message")
@@ -161,6 +163,23 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
             f"{hint}.\nSolver said: {failure.strip().splitlines()[-1][:300]}",
             t_reached, result)
     return result
+
+
+def _finite_run(dae: CasadiDAE, obs_idx: list[int], times: np.ndarray, xs: np.ndarray,
+                zs: np.ndarray, p: np.ndarray) -> bool:
+    """Whether every recorded value is finite, evaluating only the variables that can turn
+    non-finite for finite states (:func:`bgmodelica.diagnose.unsafe_outputs`); the others
+    stay lazy (computed when first read)."""
+    if not (np.all(np.isfinite(xs)) and np.all(np.isfinite(zs))):
+        return False
+    if "unsafe_observed" not in dae.cache:
+        f = ca.Function("observed", [dae.t, dae.x, dae.z, dae.p], [ca.densify(dae.observed)])
+        dae.cache["unsafe_observed"] = set(unsafe_outputs(f, (0, 1, 2)))
+    unsafe = [k for k in obs_idx if k in dae.cache["unsafe_observed"]]
+    if not unsafe or not len(times):
+        return True
+    with np.errstate(all="ignore"):
+        return bool(np.all(np.isfinite(_observer(dae, unsafe)(times, xs, zs, p))))
 
 
 def _split_overrides(dae: CasadiDAE, params: dict[str, Any]):
@@ -360,14 +379,19 @@ def _make_observer(dae: CasadiDAE, idx: list[int]) -> Callable:
     xs = ca.vertcat(*[dae.x[i] for i in used_x]) if used_x else ca.SX(0, 1)
     zs = ca.vertcat(*[dae.z[i] for i in used_z]) if used_z else ca.SX(0, 1)
     ps = ca.vertcat(*[dae.p[i] for i in used_p]) if used_p else ca.SX(0, 1)
-    f = ca.Function("observe", [dae.t, xs, zs, ps], [expr])
+    f = ca.Function("observe", [dae.t, xs, zs, ps], [ca.densify(expr)])
+    mapped: dict[int, Fast] = {}
 
     def run(times, x_traj, z_traj, p):
         n = len(times)
-        out = f.map(n)(times.reshape(1, -1), x_traj[used_x, :],
-                       z_traj[used_z, :] if used_z else np.zeros((0, n)),
-                       np.asarray(p)[used_p])     # broadcast over the grid
-        return np.asarray(out).T.reshape(n, len(idx))
+        if n not in mapped:                      # one mapped, buffered function per length
+            if len(mapped) > 8:
+                mapped.clear()
+            mapped[n] = Fast(f.map(n))
+        out = mapped[n](times, np.asarray(x_traj[used_x, :]).T.ravel(),
+                        np.asarray(z_traj[used_z, :]).T.ravel() if used_z else 0.0,
+                        np.repeat(np.asarray(p)[used_p][None, :], n, axis=0).ravel())[0]
+        return out.reshape(n, len(idx)).copy()
 
     return run
 
