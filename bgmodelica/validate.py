@@ -241,20 +241,8 @@ def _declared(v: Any, sep: str = " (") -> str:
 
 
 def _bound_values(dae: Any, bound: list, p: np.ndarray) -> list[float | None]:
-    import casadi as ca
-
-    syms = ca.vertcat(*[q.sx for q in bound])
-    vals = ca.vertcat(*[ca.SX(q.decl.value) for q in bound])
-    for _ in range(len(bound)):
-        if not ca.depends_on(vals, syms):
-            break
-        vals = ca.substitute(vals, syms, vals)
-    try:
-        f = ca.Function("bgm_bound", [dae.p], [vals])
-        out = np.asarray(f(p), dtype=float).ravel()
-    except RuntimeError:              # depends on something else than the parameters
-        return [None] * len(bound)
-    return [float(v) for v in out]
+    values = dae.parameter_values(p) if hasattr(dae, "parameter_values") else {}
+    return [values.get(q.name) for q in bound]
 
 
 # -- command-line model arguments ----------------------------------------------------------------

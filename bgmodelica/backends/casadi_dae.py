@@ -70,9 +70,14 @@ class CasadiDAE:
                     if not ca.depends_on(expr, ca.vertcat(*syms)):
                         break
                     expr = ca.substitute(expr, ca.vertcat(*syms), expr)
-                self.cache["bound_values"] = ca.Function("bound", [free], [expr])
-            vals = np.asarray(self.cache["bound_values"](p[:len(self.parameters)])).ravel()
-            out.update({q.name: float(v) for q, v in zip(self.bound, vals, strict=True)})
+                try:
+                    self.cache["bound_values"] = ca.Function("bound", [free], [expr])
+                except RuntimeError:      # bound to something else than free parameters
+                    self.cache["bound_values"] = None
+            f = self.cache["bound_values"]
+            if f is not None:
+                vals = np.asarray(f(p[:len(self.parameters)])).ravel()
+                out.update({q.name: float(v) for q, v in zip(self.bound, vals, strict=True)})
         return out
 
     @property
