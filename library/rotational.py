@@ -25,9 +25,10 @@ from bgmodelica import (
     der,
     eq,
     if_else,
-    initial,
     pre,
 )
+
+from .friction import FORWARD, UNKNOWN, stick_slip_equations
 
 __all__ = ["Flange", "PartialTwoFlanges", "Fixed", "Inertia", "Damper", "Spring",
            "SpringDamper", "IdealGear", "Torque", "ConstantTorque", "AngleSensor",
@@ -192,11 +193,7 @@ class TorqueSensor(PartialTwoFlanges):
 
 # -- Coulomb friction (hybrid: events and pre()) ---------------------------------------------
 
-#: Friction modes (Modelica.Mechanics.Rotational.Interfaces.PartialFriction)
-UNKNOWN = 3     # before initialization: the mode follows from the start speed
-FORWARD = 1     # w_relfric > 0, sliding forward
-STUCK = 0       # w_relfric = 0: locked, or about to start sliding
-BACKWARD = -1   # w_relfric < 0, sliding backward
+# Friction modes UNKNOWN, FORWARD, STUCK, BACKWARD and the state machine: library.friction
 
 
 class PartialFriction(Component):
@@ -245,32 +242,10 @@ class PartialFriction(Component):
                                               "0: stuck, 1: forward sliding, 3: unknown)")
 
     def equations(self):
-        pre_mode = pre(self.mode)
         # MSL: sa is dimensionless, scaled by unitTorque and unitAngularAcceleration
-        lim0 = self.tau0 / self.unitTorque
-        lim_max = self.tau0_max / self.unitTorque
-        yield self.startForward == (
-            (eq(pre_mode, STUCK) & ((self.sa > lim_max)
-                                    | (pre(self.startForward) & (self.sa > lim0))))
-            | (eq(pre_mode, BACKWARD) & (self.w_relfric > self.w_small))
-            | (initial() & (self.w_relfric > 0)))
-        yield self.startBackward == (
-            (eq(pre_mode, STUCK) & ((self.sa < -lim_max)
-                                    | (pre(self.startBackward) & (self.sa < -lim0))))
-            | (eq(pre_mode, FORWARD) & (self.w_relfric < -self.w_small))
-            | (initial() & (self.w_relfric < 0)))
-        yield self.locked == ~(eq(pre_mode, FORWARD) | self.startForward
-                               | eq(pre_mode, BACKWARD) | self.startBackward)
-        yield self.a_relfric / self.unitAngularAcceleration == if_else(
-            self.locked, 0.0,
-            if_else(self.startForward, self.sa - lim_max,
-                    if_else(self.startBackward, self.sa + lim_max,
-                            if_else(eq(pre_mode, FORWARD), self.sa - lim_max,
-                                    self.sa + lim_max))))
-        yield self.mode == if_else(
-            (eq(pre_mode, FORWARD) | self.startForward) & (self.w_relfric > 0), FORWARD,
-            if_else((eq(pre_mode, BACKWARD) | self.startBackward) & (self.w_relfric < 0),
-                    BACKWARD, STUCK))
+        yield from stick_slip_equations(
+            self, self.w_relfric, self.a_relfric / self.unitAngularAcceleration,
+            self.tau0 / self.unitTorque, self.tau0_max / self.unitTorque, self.w_small)
 
 
 class BearingFriction(PartialTwoFlanges, PartialFriction):

@@ -28,11 +28,12 @@ from bgmodelica import (
     der,
     eq,
     if_else,
-    initial,
     pre,
     reinit,
     when,
 )
+
+from .friction import FORWARD, UNKNOWN, stick_slip_equations
 
 __all__ = ["Flange", "PartialTwoFlanges", "PartialCompliant", "PartialRigid", "Fixed", "Mass",
            "Rod", "Spring", "Damper", "SpringDamper", "Force", "ConstantForce",
@@ -235,11 +236,7 @@ class ForceSensor(PartialTwoFlanges):
 
 # -- Coulomb friction and hard stops (hybrid: events, pre(), when/reinit) --------------------
 
-#: Friction modes (Modelica.Mechanics.Translational.Interfaces.PartialFriction)
-UNKNOWN = 3     # before initialization: the mode follows from the start velocity
-FORWARD = 1     # v_relfric > 0, sliding forward
-STUCK = 0       # v_relfric = 0: locked, or about to start sliding
-BACKWARD = -1   # v_relfric < 0, sliding backward
+# Friction modes UNKNOWN, FORWARD, STUCK, BACKWARD and the state machine: library.friction
 
 
 class PartialFriction(Component):
@@ -294,39 +291,11 @@ class PartialFriction(Component):
         return None
 
     def equations(self):
-        pre_mode = pre(self.mode)
         # MSL: sa is dimensionless, scaled by unitForce and unitAcceleration
-        lim0 = self.f0 / self.unitForce
-        lim_max = self.f0_max / self.unitForce
-        fwd, bwd = self._forward_allowed(), self._backward_allowed()
-        break_fwd = (self.sa > lim_max) | (pre(self.startForward) & (self.sa > lim0))
-        break_bwd = (self.sa < -lim_max) | (pre(self.startBackward) & (self.sa < -lim0))
-        if fwd is not None:
-            break_fwd = break_fwd & fwd
-        if bwd is not None:
-            break_bwd = break_bwd & bwd
-        yield self.startForward == ((eq(pre_mode, STUCK) & break_fwd)
-                                    | (eq(pre_mode, BACKWARD) & (self.v_relfric > self.v_small))
-                                    | (initial() & (self.v_relfric > 0)))
-        yield self.startBackward == ((eq(pre_mode, STUCK) & break_bwd)
-                                     | (eq(pre_mode, FORWARD)
-                                        & (self.v_relfric < -self.v_small))
-                                     | (initial() & (self.v_relfric < 0)))
-        yield self.locked == ~(eq(pre_mode, FORWARD) | self.startForward
-                               | eq(pre_mode, BACKWARD) | self.startBackward)
-        yield self.a_relfric / self.unitAcceleration == if_else(
-            self.locked, 0.0,
-            if_else(self.startForward, self.sa - lim_max,
-                    if_else(self.startBackward, self.sa + lim_max,
-                            if_else(eq(pre_mode, FORWARD), self.sa - lim_max,
-                                    self.sa + lim_max))))
-        going_fwd = (eq(pre_mode, FORWARD) | self.startForward) & (self.v_relfric > 0)
-        going_bwd = (eq(pre_mode, BACKWARD) | self.startBackward) & (self.v_relfric < 0)
-        if fwd is not None:
-            going_fwd = going_fwd & fwd
-        if bwd is not None:
-            going_bwd = going_bwd & bwd
-        yield self.mode == if_else(going_fwd, FORWARD, if_else(going_bwd, BACKWARD, STUCK))
+        yield from stick_slip_equations(
+            self, self.v_relfric, self.a_relfric / self.unitAcceleration,
+            self.f0 / self.unitForce, self.f0_max / self.unitForce, self.v_small,
+            self._forward_allowed(), self._backward_allowed())
 
     def _friction_force(self, v):
         """Friction force [N] (opposing v_relfric): ``sa*unitForce`` while locked, else
