@@ -1,0 +1,123 @@
+"""Shared pieces of the Modelica builder: error helpers, the evaluation context and
+numeric values of evaluated expressions.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from typing import TYPE_CHECKING, Any
+
+from ...core.component import Component, Element
+from ...core.expr import Expr, Leaf, Op
+from ...core.variables import (
+    KIND_PARAMETER,
+    TIME,
+)
+from .. import ast as A
+from .. import scope as S
+from ..errors import ModelicaError
+
+if TYPE_CHECKING:
+    from .env import Env
+
+SELF = "<self>"
+
+
+_NAME = re.compile(r"^(.*)\[([0-9,]+)\]$")
+
+
+_RESERVED = {n for n in dir(Component) if not n.startswith("__")} | {"name"}
+
+
+class NotConstant(Exception):
+    """A structural expression (array size, range, parameter-only condition) uses a value that
+    is not known when the model is built."""
+
+    def __init__(self, what: str) -> None:
+        super().__init__(what)
+        self.what = what
+
+
+class _Disabled(Exception):
+    """A reference to a conditional component that is switched off."""
+
+
+def _where(lex: S.ClassScope | None, pos: A.Pos) -> str:
+    if lex is None:
+        return "<modifier>"
+    return f"{lex.cdef.file or lex.file.file}:{pos[0]}:{pos[1]}"
+
+
+def fail(lex: S.ClassScope | None, node: Any, message: str) -> ModelicaError:
+    pos = getattr(node, "pos", (0, 0)) if not isinstance(node, tuple) else node
+    return ModelicaError(f"{_where(lex, pos)}: {message}")
+
+
+class Ctx:
+    """Evaluation context: the instance environment (or None for static values), the lexical
+    class scope, loop variables, and whether values must be known numbers."""
+
+    __slots__ = ("env", "lex", "loops", "numeric")
+
+    def __init__(self, env: Env | None, lex: S.ClassScope | None, loops: dict,
+                 numeric: bool) -> None:
+        self.env = env
+        self.lex = lex
+        self.loops = loops
+        self.numeric = numeric
+
+
+_NUM_OPS = {
+    "+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b,
+    "/": lambda a, b: a / b, "**": lambda a, b: a ** b, "<": lambda a, b: a < b,
+    "<=": lambda a, b: a <= b, "!=": lambda a, b: a != b, "==": lambda a, b: a == b,
+    "and": lambda a, b: bool(a) and bool(b), "or": lambda a, b: bool(a) or bool(b),
+    "neg": lambda a: -a, "not": lambda a: not a, "noEvent": lambda a: a,
+    "fabs": abs, "sign": lambda a: (a > 0) - (a < 0), "floor": math.floor, "ceil": math.ceil,
+    "atan2": math.atan2, "fmin": min, "fmax": max,
+    "if_else": lambda c, a, b: a if c else b,
+    **{n: getattr(math, n) for n in ("sin", "cos", "tan", "exp", "log", "sqrt", "asin", "acos",
+                                     "atan", "sinh", "cosh", "tanh")},
+}
+
+
+def numeric_value(v: Any, lex: Any = None, node: Any = None) -> Any:
+    """``v`` with parameters replaced by their values (raises :class:`NotConstant` if it
+    depends on variables or time)."""
+    if isinstance(v, (bool, int, float, str, S.EnumValue)):
+        return v
+    if isinstance(v, list):
+        return [numeric_value(x, lex, node) for x in v]
+    if isinstance(v, Leaf):
+        sym = v.sym
+        if sym is TIME:
+            raise NotConstant("time")
+        decl = getattr(sym, "decl", None)
+        if decl is None or decl.kind != KIND_PARAMETER:
+            raise NotConstant(f"{getattr(sym, 'name', sym)} is not a parameter")
+        owner = getattr(sym, "owner", None)
+        env = owner.__dict__.get("_mo_env") if owner is not None else None
+        if env is not None:
+            if sym.name in env.view.elements:
+                return env.numeric(sym.name)
+            m = _NAME.match(sym.name)
+            if m is not None and m.group(1) in env.view.elements:
+                whole = env.numeric(m.group(1))
+                for i in (int(x) for x in m.group(2).split(",")):
+                    whole = whole[i - 1] if isinstance(whole, list) else whole
+                return whole
+        return numeric_value(decl.value, lex, node)
+    if isinstance(v, Op):
+        args = [numeric_value(a, lex, node) for a in v.args]
+        fn = _NUM_OPS.get(v.op)
+        if fn is None:
+            raise NotConstant(f"operation {v.op}")
+        return fn(*args)
+    if isinstance(v, Element):
+        raise NotConstant(f"component {v.name}")
+    raise NotConstant(repr(v))
+
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (bool, int, float)) and not isinstance(v, Expr)

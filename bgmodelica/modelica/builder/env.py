@@ -1,0 +1,147 @@
+"""The instance environment (:class:`Env`): the values of an instance's elements as seen by its
+equations and modifiers, and array sizes.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ...core.component import Element
+from .. import ast as A
+from .. import scope as S
+from .base import Ctx, NotConstant, fail, numeric_value
+from .classes import ClassView, ElemInfo, TypeRef, class_view, type_ref
+from .mods import Mod, bind, merge
+
+
+class Env:
+    """An instance being built: its class view, the modifications it received, its
+    Python element once created, and memoized values of its parameters."""
+
+    __slots__ = ("view", "mods", "parent", "inst", "path", "_num", "_emod", "disabled",
+                 "_busy", "cached")
+
+    def __init__(self, view: ClassView, mods: dict[str, Mod], parent: Env | None,
+                 path: str) -> None:
+        self.view = view
+        self.mods = mods
+        self.parent = parent
+        self.inst: Element | None = None
+        self.path = path
+        self._num: dict[str, Any] = {}
+        self._emod: dict[str, Mod | None] = {}
+        self.disabled: set[str] = set()
+        self._busy: set[str] = set()
+        self.cached: tuple | None = None
+
+    def emod(self, name: str) -> Mod | None:
+        """The merged modification of element ``name``: the outer one on top of the
+        declaration's (and its type's)."""
+        if name in self._emod:
+            return self._emod[name]
+        info = self.view.elements[name]
+        own = bind(info.mod, self)
+        tref = info.tref
+        if tref is not None and tref.kind == "scalar" and tref.mod is not None:
+            own = merge(own, tref.mod)
+        m = merge(self.mods.get(name), own)
+        self._emod[name] = m
+        return m
+
+    def numeric(self, name: str) -> Any:
+        """The value of parameter / constant ``name`` when the model is built."""
+        if name in self._num:
+            return self._num[name]
+        info = self.view.elements.get(name)
+        if info is None:
+            raise KeyError(name)
+        if name in self._busy:
+            raise fail(info.lex, info.comp, f"the binding of {name} depends on itself")
+        tref = type_ref(info)
+        category = _category(info, tref)
+        if category not in ("param", "const", "string"):
+            raise NotConstant(f"{name} is a variable")
+        self._busy.add(name)
+        try:
+            m = self.emod(name)
+            if m is not None and m.has_binding:
+                value = m.value(True)
+            elif m is not None and "start" in m.sub and m.sub["start"].has_binding:
+                value = m.sub["start"].value(True)
+            else:
+                value = _default_value(tref)
+                dims = _dims(info, self, numeric=True)
+                for d in reversed(dims):
+                    value = [value] * d
+        finally:
+            self._busy.discard(name)
+        self._num[name] = value
+        return value
+
+
+def _default_value(tref: TypeRef) -> Any:
+    return {"Real": 0.0, "Integer": 0, "Boolean": False, "String": "", "enum": 1}.get(
+        tref.base, 0.0)
+
+
+def _category(info: ElemInfo, tref: TypeRef) -> str:
+    if info.category:
+        return info.category
+    pre = info.comp.prefixes
+    if tref.kind != "scalar":
+        cat = "child"
+    elif "constant" in pre:
+        cat = "const"
+    elif tref.base == "String":
+        cat = "string"
+    elif "parameter" in pre:
+        cat = "param"
+    else:
+        cat = "var"
+    info.category = cat
+    return cat
+
+
+def _dims(info: ElemInfo, env: Env | None, numeric: bool = True) -> tuple[int, ...]:
+    from .evaluate import evaluate
+
+    tref = type_ref(info)
+    exprs = [(d, tref_lex) for d, tref_lex in tref.dims] if tref.kind == "scalar" else []
+    exprs = [(d, info.lex) for d in info.comp.dims] + exprs
+    out = []
+    for k, (d, lex) in enumerate(exprs):
+        if isinstance(d, A.Colon):
+            size = _size_from_binding(info, env, k)
+        else:
+            v = evaluate(d, Ctx(env, lex, {}, True))
+            v = numeric_value(v, lex, d)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or v != int(v) or v < 0:
+                raise fail(lex, d, f"array size of {info.comp.name} must be a non-negative "
+                           f"Integer, got {v!r}")
+            size = int(v)
+        out.append(size)
+    return tuple(out)
+
+
+def _size_from_binding(info: ElemInfo, env: Env | None, k: int) -> int:
+    if env is None:
+        raise NotConstant(f"size of {info.comp.name}")
+    m = env.emod(info.comp.name)
+    if m is None or not m.has_binding:
+        raise fail(info.lex, info.comp, f"{info.comp.name}: an array size ':' needs a binding "
+                   "to take its size from")
+    v = m.value(True)
+    for _ in range(k):
+        v = v[0] if isinstance(v, list) and v else v
+    if not isinstance(v, list):
+        raise fail(info.lex, info.comp, f"{info.comp.name}: the binding is not an array")
+    return len(v)
+
+
+def static_env(scope: S.ClassScope) -> Env:
+    """An environment without instance for reading constants of a package or class."""
+    env = scope._static
+    if env is None:
+        env = Env(class_view(scope), {}, None, scope.full_name)
+        scope._static = env
+    return env

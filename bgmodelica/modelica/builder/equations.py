@@ -1,0 +1,214 @@
+"""Modelica equations (plain, ``connect``, ``for``, ``if``, ``when``) evaluated into bgmodelica
+equations for one instance.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ...core import hybrid as H
+from ...core.component import Element, connect
+from ...core.expr import Equation, Expr
+from ...errors import ConnectError, DeclarationError, EquationError, ModelError
+from .. import ast as A
+from .. import scope as S
+from ..errors import ModelicaError
+from .base import Ctx, NotConstant, _Disabled, _is_number, fail, numeric_value
+from .env import Env
+from .evaluate import _iterate, evaluate
+
+
+def _equation(a: Any, b: Any, ctx: Ctx, node: Any, out: list) -> None:
+    if isinstance(a, list) or isinstance(b, list):
+        if not (isinstance(a, list) and isinstance(b, list)):
+            if isinstance(a, list) and _is_number(b) or isinstance(b, list) and _is_number(a):
+                raise fail(ctx.lex, node, "array equation with a scalar side")
+            raise fail(ctx.lex, node, "array equation with a scalar side")
+        if len(a) != len(b):
+            raise fail(ctx.lex, node, f"array equation of sizes {len(a)} and {len(b)}")
+        for x, y in zip(a, b, strict=True):
+            _equation(x, y, ctx, node, out)
+        return
+    a = a.index if isinstance(a, S.EnumValue) else a
+    b = b.index if isinstance(b, S.EnumValue) else b
+    if isinstance(a, Element) or isinstance(b, Element):
+        raise fail(ctx.lex, node, "an equation between components: use connect(a, b)")
+    if isinstance(a, Expr):
+        out.append(Equation(a, b))
+    elif isinstance(b, Expr):
+        out.append(Equation(b, a))
+    else:
+        raise fail(ctx.lex, node, f"equation {a!r} = {b!r} has no variables")
+
+
+def equations_of(env: Env, eqs: list, initial: bool = False) -> list:
+    """The bgmodelica equations of the Modelica equations ``eqs`` for instance ``env``."""
+    out: list = []
+    for eq, lex in eqs:
+        _eval_equation(eq, Ctx(env, lex, {}, False), out, initial)
+    return out
+
+
+def _eval_equation(eq: Any, ctx: Ctx, out: list, initial: bool) -> None:
+    try:
+        if isinstance(eq, A.EqSimple):
+            try:
+                a = evaluate(eq.lhs, ctx)
+                b = evaluate(eq.rhs, ctx)
+            except NotConstant as err:
+                raise fail(ctx.lex, eq, f"cannot evaluate: {err.what}") from None
+            _equation(a, b, ctx, eq, out)
+        elif isinstance(eq, A.EqCall):
+            _eval_call_equation(eq, ctx, out, initial)
+        elif isinstance(eq, A.EqFor):
+            for loops in _iterate(eq.indices, ctx, eq):
+                inner = Ctx(ctx.env, ctx.lex, loops, False)
+                for sub in eq.body:
+                    _eval_equation(sub, inner, out, initial)
+        elif isinstance(eq, A.EqIf):
+            _eval_if_equation(eq, ctx, out, initial)
+        elif isinstance(eq, A.EqWhen):
+            if initial:
+                raise fail(ctx.lex, eq, "when-equations are not allowed in initial equations")
+            out.append(_eval_when(eq, ctx))
+        elif isinstance(eq, A.Unsupported):
+            raise fail(ctx.lex, eq, f"unsupported Modelica construct: {eq.what}")
+        else:
+            raise fail(ctx.lex, eq, f"unsupported equation {type(eq).__name__}")
+    except _Disabled:
+        if isinstance(eq, A.EqCall) and eq.call.func.dotted == "connect":
+            return
+        raise fail(ctx.lex, eq, "the equation uses a conditional component that is switched "
+                   "off") from None
+    except (ConnectError, EquationError, DeclarationError) as err:
+        if isinstance(err, ModelicaError):
+            raise
+        raise fail(ctx.lex, eq, str(err)) from None
+
+
+def _eval_call_equation(eq: A.EqCall, ctx: Ctx, out: list, initial: bool) -> None:
+    call = eq.call
+    name = call.func.dotted
+    if name == "connect":
+        if len(call.args) != 2 or call.kwargs:
+            raise fail(ctx.lex, eq, "connect(a, b) takes two connectors")
+        a = evaluate(call.args[0], ctx)
+        b = evaluate(call.args[1], ctx)
+        _connect(a, b, ctx, eq, out)
+        return
+    if name == "assert":
+        return
+    if name == "reinit":
+        raise fail(ctx.lex, eq, "reinit() is allowed only inside a when-equation")
+    if name == "terminate":
+        raise fail(ctx.lex, eq, "unsupported Modelica construct: terminate()")
+    raise fail(ctx.lex, eq, f"{name}(...) is not an equation (write 'expression = "
+               "expression')")
+
+
+def _connect(a: Any, b: Any, ctx: Ctx, node: Any, out: list) -> None:
+    if isinstance(a, list) or isinstance(b, list):
+        if not (isinstance(a, list) and isinstance(b, list) and len(a) == len(b)):
+            raise fail(ctx.lex, node, "connect() of arrays of different sizes")
+        for x, y in zip(a, b, strict=True):
+            _connect(x, y, ctx, node, out)
+        return
+    out.append(connect(a, b))
+
+
+def _eval_if_equation(eq: A.EqIf, ctx: Ctx, out: list, initial: bool) -> None:
+    symbolic = []
+    for cond, body in eq.branches:
+        try:
+            c = numeric_value(evaluate(cond, Ctx(ctx.env, ctx.lex, ctx.loops, True)), ctx.lex,
+                              cond)
+        except NotConstant:
+            c = None
+        if c is None:
+            symbolic.append((evaluate(cond, ctx), body))
+            continue
+        if c:
+            if not symbolic:
+                for sub in body:
+                    _eval_equation(sub, ctx, out, initial)
+                return
+            symbolic.append((True, body))
+            break
+    else:
+        if not symbolic:
+            for sub in eq.otherwise:
+                _eval_equation(sub, ctx, out, initial)
+            return
+        symbolic.append((True, eq.otherwise))
+    branches = []
+    for c, body in symbolic:
+        eqs: list = []
+        for sub in body:
+            _eval_equation(sub, ctx, eqs, initial)
+        for e in eqs:
+            if not isinstance(e, Equation):
+                raise fail(ctx.lex, eq, "an if-equation with a condition that changes during "
+                           "the simulation may hold only equations 'a = b'")
+        branches.append((c, eqs))
+    otherwise = branches.pop()[1] if branches[-1][0] is True else []
+    first_c, first = branches[0]
+    try:
+        out.append(H.if_equation(first_c, first, otherwise, *branches[1:]))
+    except ModelError as err:
+        raise fail(ctx.lex, eq, str(err)) from None
+
+
+def _eval_when(eq: A.EqWhen, ctx: Ctx) -> Any:
+    result = None
+    for cond, body in eq.branches:
+        c = evaluate(cond, ctx)
+        stmts: list = []
+        for st in body:
+            if isinstance(st, A.EqSimple):
+                a = evaluate(st.lhs, ctx)
+                b = evaluate(st.rhs, ctx)
+                _equation(a, b, ctx, st, stmts)
+            elif isinstance(st, A.EqCall) and st.call.func.dotted == "reinit":
+                if len(st.call.args) != 2:
+                    raise fail(ctx.lex, st, "reinit(x, value) takes two arguments")
+                x = evaluate(st.call.args[0], ctx)
+                v = evaluate(st.call.args[1], ctx)
+                xs, vs = (x, v) if isinstance(x, list) else ([x], [v])
+                for xi, vi in zip(xs, vs if isinstance(vs, list) else [vs] * len(xs),
+                                  strict=True):
+                    try:
+                        stmts.append(H.reinit(xi, vi))
+                    except ModelError as err:
+                        raise fail(ctx.lex, st, str(err)) from None
+            elif isinstance(st, A.EqCall) and st.call.func.dotted in ("assert",):
+                continue
+            elif isinstance(st, A.EqCall) and st.call.func.dotted == "terminate":
+                raise fail(ctx.lex, st, "unsupported Modelica construct: terminate()")
+            else:
+                raise fail(ctx.lex, st, "unsupported Modelica construct in a when-equation "
+                           "(supported: 'v = expression' and reinit(x, value))")
+        try:
+            if result is None:
+                result = H.when(c, *stmts)
+            else:
+                result.elsewhen(c, *stmts)
+        except ModelError as err:
+            raise fail(ctx.lex, eq, str(err)) from None
+    return result
+
+
+def _declaration_equations(inst: Element, bindings: list, connector: bool) -> None:
+    """``Real x = expr`` (in the class or from a modifier): the equation ``x = expr``,
+    evaluated where the binding is written."""
+    eqs: list = []
+    for sym, m, info in bindings:
+        lex = m.lex or info.lex
+        if connector:
+            raise fail(lex, m.pos, f"{info.comp.name}: a connector variable cannot have a "
+                       "declaration equation")
+        try:
+            value = m.value(False)
+        except NotConstant as err:
+            raise fail(lex, m.pos, f"{info.comp.name}: {err.what}") from None
+        _equation(sym.leaf, value, Ctx(None, lex, {}, False), m, eqs)
+    inst._equations.extend(eqs)

@@ -1,0 +1,412 @@
+"""Modelica built-in functions and operators (``der``, ``pre``, ``sample``, ``size``, ``zeros``,
+``min``/``max``/``sum``, ...) as evaluated by the builder.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from ...core import expressions as X
+from ...core import hybrid as H
+from ...core.expr import Expr, Leaf, Op
+from ...errors import ModelError
+from .. import ast as A
+from .. import scope as S
+from .base import Ctx, NotConstant, fail, numeric_value
+from .evaluate import _comprehension, _flatten, _num_or_expr, _shape, _sum, evaluate
+
+
+def _ev_call(node: A.Call, ctx: Ctx) -> Any:
+    fname = _function_name(node, ctx)
+    handler = _FUNCTIONS.get(fname)
+    if handler is None:
+        raise fail(ctx.lex, node, f"{node.func.dotted}() is not supported here")
+    return handler(node, ctx)
+
+
+def _function_name(node: A.Call, ctx: Ctx) -> str:
+    ref = node.func
+    parts = [p for p, _ in ref.parts]
+    if len(parts) == 1:
+        name = parts[0]
+        found = S.lookup(ctx.lex, name) if ctx.lex is not None else None
+        if found is None or isinstance(found, S.Builtin):
+            if name in _FUNCTIONS:
+                return name
+            raise fail(ctx.lex, node, f"unknown function {name}()")
+        if isinstance(found, S.ClassScope):
+            return _user_function(found, node, ctx)
+        raise fail(ctx.lex, node, f"{name} is not a function")
+    found = S.lookup(ctx.lex, parts[0]) if ctx.lex is not None else None
+    got = S.walk(found, parts[1:]) if found is not None else None
+    if isinstance(got, tuple) and got and got[0] == "function":
+        return got[1]
+    if isinstance(got, S.ClassScope):
+        return _user_function(got, node, ctx)
+    raise fail(ctx.lex, node, f"unknown function {ref.dotted}()")
+
+
+def _user_function(found: S.ClassScope, node: A.Call, ctx: Ctx) -> str:
+    kind = found.cdef.kind
+    if kind == "function":
+        raise fail(ctx.lex, node, f"unsupported Modelica construct: call of the user-defined "
+                   f"function {found.full_name}() (only the built-in functions are supported)")
+    if kind == "record":
+        raise fail(ctx.lex, node, f"unsupported Modelica construct: record constructor "
+                   f"{found.full_name}()")
+    if found.cdef.short is not None or found.cdef.enum is not None:
+        name = found.cdef.name
+        if name in ("Real", "Integer"):
+            return name
+    raise fail(ctx.lex, node, f"{found.full_name} is a {kind}, not a function")
+
+
+def _args(node: A.Call, ctx: Ctx, n: int | tuple[int, ...], name: str) -> list:
+    if node.iterator is not None:
+        raise fail(ctx.lex, node, f"{name}() does not take an iterator")
+    counts = (n,) if isinstance(n, int) else n
+    if len(node.args) not in counts or node.kwargs:
+        raise fail(ctx.lex, node, f"{name}() takes {' or '.join(map(str, counts))} "
+                   f"positional argument(s), got {len(node.args)}"
+                   + (f" and named {', '.join(node.kwargs)}" if node.kwargs else ""))
+    return [evaluate(a, ctx) for a in node.args]
+
+
+def _elementwise(fn):
+    def apply(x):
+        if isinstance(x, list):
+            return [apply(v) for v in x]
+        if isinstance(x, S.EnumValue):
+            x = x.index
+        return fn(x)
+    return apply
+
+
+def _unary_fn(name: str, fn):
+    def handler(node: A.Call, ctx: Ctx) -> Any:
+        (x,) = _args(node, ctx, 1, name)
+        try:
+            return _elementwise(fn)(x)
+        except (ValueError, OverflowError) as err:
+            raise fail(ctx.lex, node, f"{name}({x!r}): {err}") from None
+    return handler
+
+
+def _log10(x: Any) -> Any:
+    if isinstance(x, Expr):
+        return X.log(x) / math.log(10.0)
+    return math.log10(x)
+
+
+def _floor(x: Any) -> Any:
+    if isinstance(x, Expr):
+        return Op("floor", (x,))
+    return math.floor(x)
+
+
+def _ceil(x: Any) -> Any:
+    if isinstance(x, Expr):
+        return Op("ceil", (x,))
+    return math.ceil(x)
+
+
+def _symbolic(ctx: Ctx, node: Any, name: str) -> None:
+    if ctx.numeric:
+        raise NotConstant(f"{name}()")
+
+
+def _fn_der(node: A.Call, ctx: Ctx) -> Any:
+    _symbolic(ctx, node, "der")
+    (x,) = _args(node, ctx, 1, "der")
+    try:
+        return _elementwise(X.der)(x)
+    except ModelError as err:
+        raise fail(ctx.lex, node, str(err)) from None
+
+
+def _leaf_arg(x: Any, ctx: Ctx, node: Any, name: str) -> Any:
+    if isinstance(x, list):
+        return [_leaf_arg(v, ctx, node, name) for v in x]
+    if not isinstance(x, Leaf):
+        raise fail(ctx.lex, node, f"{name}() takes a variable, got {x!r}")
+    return x
+
+
+def _fn_pre(node: A.Call, ctx: Ctx) -> Any:
+    _symbolic(ctx, node, "pre")
+    (x,) = _args(node, ctx, 1, "pre")
+    x = _leaf_arg(x, ctx, node, "pre")
+    return _elementwise(H.pre)(x)
+
+
+def _fn_edge(node: A.Call, ctx: Ctx) -> Any:
+    _symbolic(ctx, node, "edge")
+    (x,) = _args(node, ctx, 1, "edge")
+    return _elementwise(H.edge)(_leaf_arg(x, ctx, node, "edge"))
+
+
+def _fn_change(node: A.Call, ctx: Ctx) -> Any:
+    _symbolic(ctx, node, "change")
+    (x,) = _args(node, ctx, 1, "change")
+    return _elementwise(H.change)(_leaf_arg(x, ctx, node, "change"))
+
+
+def _fn_initial(node: A.Call, ctx: Ctx) -> Any:
+    _symbolic(ctx, node, "initial")
+    _args(node, ctx, 0, "initial")
+    return H.initial()
+
+
+def _fn_terminal(node: A.Call, ctx: Ctx) -> Any:
+    _symbolic(ctx, node, "terminal")
+    _args(node, ctx, 0, "terminal")
+    return H.terminal()
+
+
+def _fn_sample(node: A.Call, ctx: Ctx) -> Any:
+    _symbolic(ctx, node, "sample")
+    if node.kwargs:
+        args = [evaluate(node.kwargs.get("start", A.Num(0)), ctx),
+                evaluate(node.kwargs["interval"], ctx)] if "interval" in node.kwargs else []
+    else:
+        args = _args(node, ctx, 2, "sample")
+    if len(args) != 2:
+        raise fail(ctx.lex, node, "sample(start, interval) takes two arguments")
+    start, interval = (a.index if isinstance(a, S.EnumValue) else a for a in args)
+    try:
+        return H.sample(start, interval)
+    except ModelError as err:
+        raise fail(ctx.lex, node, str(err)) from None
+
+
+def _fn_noevent(node: A.Call, ctx: Ctx) -> Any:
+    (x,) = _args(node, ctx, 1, "noEvent")
+    return _elementwise(H.no_event)(x)
+
+
+def _fn_smooth(node: A.Call, ctx: Ctx) -> Any:
+    _, x = _args(node, ctx, 2, "smooth")
+    return x
+
+
+def _fn_homotopy(node: A.Call, ctx: Ctx) -> Any:
+    if node.kwargs:
+        if "actual" not in node.kwargs:
+            raise fail(ctx.lex, node, "homotopy() needs actual=")
+        return evaluate(node.kwargs["actual"], ctx)
+    actual, _ = _args(node, ctx, 2, "homotopy")
+    return actual
+
+
+def _minmax(name: str):
+    pick2 = X.fmin if name == "min" else X.fmax
+
+    def handler(node: A.Call, ctx: Ctx) -> Any:
+        if node.iterator is not None:
+            items = _comprehension(node.iterator[0], node.iterator[1], ctx, node)
+            items = _flatten(items)
+        else:
+            args = _args(node, ctx, (1, 2), name)
+            items = _flatten(args[0]) if len(args) == 1 else args
+            if len(args) == 2 and (isinstance(args[0], list) or isinstance(args[1], list)):
+                raise fail(ctx.lex, node, f"{name}(a, b) of arrays: use {name}(array)")
+        if not items:
+            raise fail(ctx.lex, node, f"{name}() of an empty array")
+        items = [_num_or_expr(v, ctx, node) for v in items]
+        out = items[0]
+        for v in items[1:]:
+            out = pick2(out, v)
+        return out
+    return handler
+
+
+def _reduction(name: str):
+    def handler(node: A.Call, ctx: Ctx) -> Any:
+        if node.iterator is not None:
+            items = _flatten(_comprehension(node.iterator[0], node.iterator[1], ctx, node))
+        else:
+            (a,) = _args(node, ctx, 1, name)
+            items = _flatten(a)
+        if name == "sum":
+            return _sum(items)
+        out: Any = 1
+        for v in items:
+            out = out * v
+        return out
+    return handler
+
+
+def _fn_abs(x: Any) -> Any:
+    return X.fabs(x) if isinstance(x, Expr) else abs(x)
+
+
+def _fn_sign(x: Any) -> Any:
+    return X.sign(x) if isinstance(x, Expr) else (x > 0) - (x < 0)
+
+
+def _fn_atan2(node: A.Call, ctx: Ctx) -> Any:
+    y, x = _args(node, ctx, 2, "atan2")
+    return X.atan2(y, x)
+
+
+def _fn_mod(node: A.Call, ctx: Ctx) -> Any:
+    x, y = _args(node, ctx, 2, "mod")
+    if isinstance(x, Expr) or isinstance(y, Expr):
+        return x - _floor(x / y) * y
+    return x - math.floor(x / y) * y
+
+
+def _fn_rem(node: A.Call, ctx: Ctx) -> Any:
+    x, y = _args(node, ctx, 2, "rem")
+    if isinstance(x, Expr) or isinstance(y, Expr):
+        q = x / y
+        return x - X.if_else(q < 0, _ceil(q), _floor(q)) * y
+    return math.fmod(x, y)
+
+
+def _fn_div(node: A.Call, ctx: Ctx) -> Any:
+    x, y = _args(node, ctx, 2, "div")
+    if isinstance(x, Expr) or isinstance(y, Expr):
+        q = x / y
+        return X.if_else(q < 0, _ceil(q), _floor(q))
+    q = x / y
+    return math.trunc(q)
+
+
+def _fn_size(node: A.Call, ctx: Ctx) -> Any:
+    args = _args(node, ctx, (1, 2), "size")
+    shape = _shape(args[0])
+    if len(args) == 1:
+        return list(shape)
+    k = numeric_value(args[1], ctx.lex, node)
+    if not 1 <= k <= len(shape):
+        raise fail(ctx.lex, node, f"size(a, {k}): a has {len(shape)} dimension(s)")
+    return shape[int(k) - 1]
+
+
+def _sizes(node: A.Call, ctx: Ctx, name: str, first: int = 0) -> tuple[list, list[int]]:
+    if node.kwargs or node.iterator is not None:
+        raise fail(ctx.lex, node, f"{name}() takes positional arguments")
+    vals = [evaluate(a, ctx) for a in node.args]
+    dims = []
+    for v in vals[first:]:
+        v = numeric_value(v, ctx.lex, node)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or v != int(v) or v < 0:
+            raise fail(ctx.lex, node, f"{name}(): sizes must be non-negative Integers")
+        dims.append(int(v))
+    return vals, dims
+
+
+def _filled(value: Any, dims: list[int]) -> Any:
+    if not dims:
+        return value
+    return [_filled(value, dims[1:]) for _ in range(dims[0])]
+
+
+def _fn_zeros(node: A.Call, ctx: Ctx) -> Any:
+    return _filled(0, _sizes(node, ctx, "zeros")[1])
+
+
+def _fn_ones(node: A.Call, ctx: Ctx) -> Any:
+    return _filled(1, _sizes(node, ctx, "ones")[1])
+
+
+def _fn_fill(node: A.Call, ctx: Ctx) -> Any:
+    vals, dims = _sizes(node, ctx, "fill", 1)
+    return _filled(vals[0], dims)
+
+
+def _fn_identity(node: A.Call, ctx: Ctx) -> Any:
+    _, (n,) = _sizes(node, ctx, "identity")
+    return [[1 if i == j else 0 for j in range(n)] for i in range(n)]
+
+
+def _fn_linspace(node: A.Call, ctx: Ctx) -> Any:
+    a, b, n = _args(node, ctx, 3, "linspace")
+    n = int(numeric_value(n, ctx.lex, node))
+    if n < 2:
+        raise fail(ctx.lex, node, "linspace(x1, x2, n) needs n >= 2")
+    return [a + (b - a) * k / (n - 1) for k in range(n)]
+
+
+def _fn_transpose(node: A.Call, ctx: Ctx) -> Any:
+    (m,) = _args(node, ctx, 1, "transpose")
+    if len(_shape(m)) != 2:
+        raise fail(ctx.lex, node, "transpose() of a matrix")
+    return [list(r) for r in zip(*m, strict=True)]
+
+
+def _fn_vector(node: A.Call, ctx: Ctx) -> Any:
+    (m,) = _args(node, ctx, 1, "vector")
+    return _flatten(m)
+
+
+def _fn_scalar(node: A.Call, ctx: Ctx) -> Any:
+    (m,) = _args(node, ctx, 1, "scalar")
+    flat = _flatten(m)
+    if len(flat) != 1:
+        raise fail(ctx.lex, node, "scalar() of an array with more than one element")
+    return flat[0]
+
+
+def _fn_integer(node: A.Call, ctx: Ctx) -> Any:
+    (x,) = _args(node, ctx, 1, "integer")
+    if isinstance(x, S.EnumValue):
+        return x.index
+    return _floor(x) if isinstance(x, Expr) else int(math.floor(x))
+
+
+def _fn_real(node: A.Call, ctx: Ctx) -> Any:
+    (x,) = _args(node, ctx, 1, "Real")
+    return float(x) if isinstance(x, (int, float)) else x
+
+
+def _fn_cross(node: A.Call, ctx: Ctx) -> Any:
+    a, b = _args(node, ctx, 2, "cross")
+    if _shape(a) != (3,) or _shape(b) != (3,):
+        raise fail(ctx.lex, node, "cross() of two 3-vectors")
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def _fn_unsupported(name: str, what: str):
+    def handler(node: A.Call, ctx: Ctx) -> Any:
+        raise fail(ctx.lex, node, f"unsupported Modelica construct: {what}")
+    return handler
+
+
+def _fn_statement(name: str):
+    def handler(node: A.Call, ctx: Ctx) -> Any:
+        raise fail(ctx.lex, node, f"{name}() is a statement of an equation section, not an "
+                   "expression")
+    return handler
+
+
+_FUNCTIONS: dict[str, Any] = {
+    "der": _fn_der, "pre": _fn_pre, "edge": _fn_edge, "change": _fn_change,
+    "initial": _fn_initial, "terminal": _fn_terminal, "sample": _fn_sample,
+    "noEvent": _fn_noevent, "smooth": _fn_smooth, "homotopy": _fn_homotopy,
+    "abs": _unary_fn("abs", _fn_abs), "sign": _unary_fn("sign", _fn_sign),
+    "sqrt": _unary_fn("sqrt", X.sqrt), "sin": _unary_fn("sin", X.sin),
+    "cos": _unary_fn("cos", X.cos), "tan": _unary_fn("tan", X.tan),
+    "asin": _unary_fn("asin", X.asin), "acos": _unary_fn("acos", X.acos),
+    "atan": _unary_fn("atan", X.atan), "sinh": _unary_fn("sinh", X.sinh),
+    "cosh": _unary_fn("cosh", X.cosh), "tanh": _unary_fn("tanh", X.tanh),
+    "exp": _unary_fn("exp", X.exp), "log": _unary_fn("log", X.log),
+    "log10": _unary_fn("log10", _log10), "floor": _unary_fn("floor", _floor),
+    "ceil": _unary_fn("ceil", _ceil), "atan2": _fn_atan2,
+    "min": _minmax("min"), "max": _minmax("max"), "sum": _reduction("sum"),
+    "product": _reduction("product"), "mod": _fn_mod, "rem": _fn_rem, "div": _fn_div,
+    "size": _fn_size, "zeros": _fn_zeros, "ones": _fn_ones, "fill": _fn_fill,
+    "identity": _fn_identity, "linspace": _fn_linspace, "transpose": _fn_transpose,
+    "vector": _fn_vector, "scalar": _fn_scalar, "integer": _fn_integer,
+    "Integer": _fn_integer, "Real": _fn_real, "cross": _fn_cross,
+    "delay": _fn_unsupported("delay", "delay() (time delays)"),
+    "spatialDistribution": _fn_unsupported("spatialDistribution", "spatialDistribution()"),
+    "cardinality": _fn_unsupported("cardinality", "cardinality()"),
+    "inStream": _fn_unsupported("inStream", "stream connectors (inStream)"),
+    "actualStream": _fn_unsupported("actualStream", "stream connectors (actualStream)"),
+    "String": _fn_unsupported("String", "String() conversions"),
+    "connect": _fn_statement("connect"), "reinit": _fn_statement("reinit"),
+    "assert": _fn_statement("assert"), "terminate": _fn_statement("terminate"),
+}
