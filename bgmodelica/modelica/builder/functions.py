@@ -13,8 +13,9 @@ from ...core.expr import Expr, Leaf, Op
 from ...errors import ModelError
 from .. import ast as A
 from .. import scope as S
+from .arith import _flatten, _num_or_expr, _shape, _sum
 from .base import Ctx, NotConstant, fail, numeric_value
-from .evaluate import _comprehension, _flatten, _num_or_expr, _shape, _sum, evaluate
+from .evaluate import _comprehension, evaluate
 
 
 def _ev_call(node: A.Call, ctx: Ctx) -> Any:

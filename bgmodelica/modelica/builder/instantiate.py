@@ -14,12 +14,13 @@ from ...errors import ModelError
 from .. import ast as A
 from .. import scope as S
 from ..errors import ModelicaError
+from .arith import _neg
 from .base import _RESERVED, SELF, Ctx, NotConstant, fail, numeric_value
 from .classes import ClassView, ElemInfo, TypeRef, class_view, resolve_class, type_ref
 from .declarations import _elem_name, _indices, _instance_decl, _override, _static_decl, apply_mods
 from .env import Env, _category, _dims
 from .equations import _declaration_equations, equations_of
-from .evaluate import _neg, evaluate
+from .evaluate import evaluate
 from .mods import Mod, _without_redeclare, index_mod, merge, mod_from_ast
 
 
