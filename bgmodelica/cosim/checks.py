@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 from ..fmi.units import parse_unit
 from .errors import (
@@ -36,6 +37,10 @@ from .errors import (
 )
 from .fmu import FmuInfo, FmuVariable
 from .ssp import SystemStructure
+from .values import to_fmi
+
+#: variable kinds that are not signals (set by name only)
+NOT_SIGNALS = ("String", "Binary")
 
 
 @dataclass
@@ -69,23 +74,30 @@ def units_compatible(a: str, b: str) -> bool:
 
 
 def check_parameter_value(element: str, info: FmuInfo, name: str, value: object,
-                          what: str = "parameter binding", unit: str = "") -> float:
+                          what: str = "parameter binding", unit: str = "") -> Any:
     """Check that ``element.name = value`` can be set before initialization of the FMU
-    ``info`` (exists, settable real parameter or input, finite, in ``[min, max]``, ``unit``
-    compatible); return the value as a float."""
+    ``info`` (exists, settable parameter or input, a value of its type, finite, in
+    ``[min, max]``, ``unit`` compatible); return the value as a float (numeric and Boolean
+    variables), a str (String) or bytes (Binary)."""
     var: FmuVariable | None = info.variables.get(name)
     where = f"{what} {element}.{name}"
     if var is None:
         raise UnknownConnectorError(f"{where}: {info.path.name} has no variable {name!r}")
-    if not var.settable or var.type != "Real":
+    if not var.settable:
         raise InvalidParameterError(
             f"{where}: it is a {var.variability} {var.causality} {var.type} of "
-            f"{info.path.name}, not a real parameter that can be set (only tunable or fixed "
+            f"{info.path.name}, not a parameter that can be set (only tunable or fixed "
             "parameters and the start values of inputs can)")
+    if var.type in ("String", "Binary"):
+        try:
+            return to_fmi(var.fmi_type or var.type, value, where)
+        except (TypeError, ValueError) as err:
+            raise InvalidParameterError(str(err)) from None
     try:
-        x = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise InvalidParameterError(f"{where}: {value!r} is not a number") from None
+        x = float(to_fmi(var.fmi_type or var.type, value, where))
+    except (TypeError, ValueError) as err:
+        msg = str(err) if var.type != "Real" else f"{where}: {value!r} is not a number"
+        raise InvalidParameterError(msg) from None
     if not math.isfinite(x):
         raise InvalidParameterError(f"{where}: the value {x} is not finite")
     if var.out_of_range(x):
@@ -168,9 +180,10 @@ def check_system(system: SystemStructure, infos: dict[str, FmuInfo],
             raise ConnectorMismatchError(
                 f"connection {con}: type mismatch, {con.start} is {a.type} and {con.end} is "
                 f"{b.type}")
-        if a.type != "Real":
+        if a.type in ("String", "Binary"):
             raise ConnectorMismatchError(
-                f"connection {con}: only Real connectors are supported, not {a.type}")
+                f"connection {con}: {a.type} variables cannot be connected (only numeric, "
+                "Boolean and enumeration signals can); set them as parameters instead")
         if not units_compatible(a.unit, b.unit):
             raise ConnectorMismatchError(
                 f"connection {con}: unit mismatch, {con.start} is in {a.unit!r} and "
@@ -184,14 +197,16 @@ def check_system(system: SystemStructure, infos: dict[str, FmuInfo],
         if con.start_connector not in used_outputs[con.start_element]:
             used_outputs[con.start_element].append(con.start_connector)
 
-    inputs = {n: [v.name for v in infos[n].inputs] for n in names}
+    inputs = {n: [v.name for v in infos[n].inputs if v.type not in NOT_SIGNALS]
+              for n in names}
     unconnected = [f"{n}.{u}" for n in names for u in inputs[n] if (n, u) not in sources]
     if unconnected and not allow_unconnected:
         raise UnconnectedInputError(
             f"input(s) not connected to any output: {', '.join(unconnected)} (connect them, "
             "or allow_unconnected=True to keep their start values)", unconnected)
     outputs = {n: used_outputs[n] + [v.name for v in infos[n].outputs
-                                     if v.name not in used_outputs[n]] for n in names}
+                                     if v.name not in used_outputs[n]
+                                     and v.type not in NOT_SIGNALS] for n in names}
     feed = {n: infos[n].feedthrough for n in names}
     order = _evaluation_order(names, inputs, outputs, sources, feed)
     return Plan(inputs, outputs, sources, order, feed, unconnected)

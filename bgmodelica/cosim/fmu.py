@@ -1,37 +1,22 @@
-"""FMUs as co-simulation units: what the ``modelDescription.xml`` says (:class:`FmuInfo`) and
-how to run them through fmpy's low-level API (:class:`CoSimUnit`, :class:`ModelExchangeUnit`).
+"""What an FMU's ``modelDescription.xml`` says, as the master needs it (:class:`FmuInfo`,
+:class:`FmuVariable`), and the FMU archives unpacked once per process.
 
-Both unit kinds offer the same small interface to the master: ``setup`` (instantiate, set
-parameters, initialize), ``set_inputs``, ``get``, ``step(t, h, ramp)`` and ``terminate``.
-
-* :class:`CoSimUnit` calls the FMU's own ``doStep`` (FMI 2.0 ``FMU2Slave`` or FMI 3.0
-  ``FMU3Slave``); inputs are held over the step (the exported FMUs declare
-  ``canInterpolateInputs="false"``), so a ramp given by the master is replaced by its mean
-  over the step, which has the same integral.
-* :class:`ModelExchangeUnit` integrates a Model Exchange FMU itself (``FMU2Model`` /
-  ``FMU3Model``) over each macro step with SciPy's Radau IIA (order 5, L-stable, error
-  controlled with ``rtol``/``atol``), the inputs following the ramp ``u0 + slope (t - t0)``.
-  The last internal step size is carried over to the next macro step.
-
-Only real-valued (Real / Float64) inputs and outputs are supported as connectors.
+Variables of every FMI type are listed with their exact type; FMI 3.0 array variables are
+listed as their elements ``x[1]``, ``x[2]``... (row-major, 1-based, ``A[1,2]`` for matrices),
+so connections, parameters and results name single elements. How the units run FMUs is in
+:mod:`.units` and :mod:`.me_unit`.
 
 FMU archives are checked and unpacked by :mod:`.archive` (never ``extractall``): an unsafe,
 truncated or non-FMU zip raises :class:`~.errors.UnsafeArchiveError` /
-:class:`~.errors.FmuFormatError` naming the file. The units capture the FMU's log messages;
-when an FMU call fails, the :class:`~.errors.CosimStepError` carries the FMU's own error
-message (e.g. which parameter is out of range).
+:class:`~.errors.FmuFormatError` naming the file.
 """
 
 from __future__ import annotations
 
 import atexit
-import collections
-import ctypes
-import itertools
 import math
 import shutil
 import tempfile
-import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -39,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from .archive import SafeZip, _one_line
-from .errors import CosimStepError, FmuFormatError, SetupError, UnknownConnectorError
+from .errors import FmuFormatError, UnknownConnectorError
 
 MODEL_DESCRIPTION = "modelDescription.xml"
 
@@ -68,6 +53,12 @@ class FmuVariable:
     description: str = ""
     min: float | None = None
     max: float | None = None
+    fmi_type: str = ""        # the exact FMI type: "Float32", "UInt16", "Enumeration"...
+    element: int = 0          # FMI 3.0 arrays: the element's row-major offset in its array
+    array_size: int = 1       # ... and the array's number of elements (1: a scalar)
+    array_start: tuple = ()   # ... and the start values of the whole array
+    start_text: Any = None    # the start value as declared (String, Binary: the only one)
+    base: str = ""            # the array's name ("" for scalars)
 
     @property
     def settable(self) -> bool:
@@ -114,6 +105,8 @@ class FmuInfo:
     cs_identifier: str | None = None
     me_identifier: str | None = None
     n_states: int = 0
+    n_event_indicators: int = 0
+    scheduled_execution: bool = False       # FMI 3.0 Scheduled Execution offered
     description: Any = field(default=None, repr=False)   # the fmpy ModelDescription
 
     @property
@@ -158,25 +151,42 @@ def read_fmu_info(path: str | Path) -> FmuInfo:
                              "(FMI 2.0 and 3.0 are)")
     variables: dict[str, FmuVariable] = {}
     for v in md.modelVariables:
-        start = None
+        if v.type == "Clock":
+            continue                  # clocks belong to Scheduled Execution
         kind = _kind_of_type(v.type)
-        if v.start is not None and kind == "Real":
-            try:
-                start = float(v.start)
-            except (TypeError, ValueError):
-                start = None
+        fmi_type = "Enumeration" if kind == "Enumeration" else v.type
         dt = v.declaredType
         unit = v.unit or (dt.unit if dt is not None and getattr(dt, "unit", None) else "") or ""
         lo = hi = None
         if kind in ("Real", "Integer"):
             lo = _bound(getattr(v, "min", None), getattr(dt, "min", None))
             hi = _bound(getattr(v, "max", None), getattr(dt, "max", None))
-        if v.name in variables:
-            raise FmuFormatError(f"{path}: {MODEL_DESCRIPTION} declares the variable "
-                                 f"{v.name!r} twice")
-        variables[v.name] = FmuVariable(v.name, int(v.valueReference), str(v.causality),
-                                        str(v.variability), kind, unit, start,
-                                        v.description or "", lo, hi)
+        shape = tuple(int(s) for s in (getattr(v, "shape", None) or ()))
+        starts = _start_values(v.start, kind, max(1, int(np.prod(shape))) if shape else 1)
+        base = dict(causality=str(v.causality), variability=str(v.variability), type=kind,
+                    unit=unit, description=v.description or "", min=lo, max=hi,
+                    fmi_type=fmi_type)
+        if not shape:
+            entries = [(v.name, 0, starts[0] if starts else None)]
+            size, array_start, base_name = 1, (), ""
+        else:
+            size = int(np.prod(shape))
+            idx = np.array(np.unravel_index(np.arange(size), shape)).T + 1
+            entries = [(f"{v.name}[{','.join(str(int(i)) for i in row)}]", k,
+                        starts[k] if k < len(starts) else None) for k, row in enumerate(idx)]
+            fill = 0.0 if kind not in ("String", "Binary") else ""
+            array_start = tuple(s if s is not None else fill for s in
+                                (starts + [None] * size)[:size])
+            base_name = v.name
+        for name, k, start in entries:
+            if name in variables:
+                raise FmuFormatError(f"{path}: {MODEL_DESCRIPTION} declares the variable "
+                                     f"{name!r} twice")
+            numeric = start if kind not in ("String", "Binary") else None
+            variables[name] = FmuVariable(name, int(v.valueReference), start=numeric,
+                                          element=k, array_size=size,
+                                          array_start=array_start, start_text=start,
+                                          base=base_name, **base)
     inputs = [v.name for v in variables.values() if v.causality == "input"]
     feedthrough = {v.name: list(inputs) for v in variables.values() if v.causality == "output"}
     for unknown in md.outputs:
@@ -189,7 +199,40 @@ def read_fmu_info(path: str | Path) -> FmuInfo:
                    variables=variables, feedthrough=feedthrough,
                    cs_identifier=md.coSimulation.modelIdentifier if md.coSimulation else None,
                    me_identifier=md.modelExchange.modelIdentifier if md.modelExchange else None,
-                   n_states=len(md.derivatives), description=md)
+                   n_states=int(md.numberOfContinuousStates or 0),
+                   n_event_indicators=int(md.numberOfEventIndicators or 0),
+                   scheduled_execution=getattr(md, "scheduledExecution", None) is not None,
+                   description=md)
+
+
+def _start_values(start: Any, kind: str, size: int) -> list[Any]:
+    """The declared start value(s) of a variable, as floats for numeric kinds (Boolean:
+    1.0/0.0), as text for String and as bytes for Binary; [] when there is none."""
+    if start is None:
+        return []
+    if kind == "String":
+        return [str(start)]
+    parts = start if isinstance(start, (list, tuple)) else str(start).split() if size > 1 \
+        else [start]
+    out: list[Any] = []
+    for p in parts:
+        if kind == "Binary":
+            try:
+                out.append(bytes.fromhex(str(p)))
+            except ValueError:
+                out.append(None)
+            continue
+        text = str(p).strip().lower()
+        if kind == "Boolean" or text in ("true", "false"):
+            out.append(1.0 if text in ("true", "1") else 0.0)
+            continue
+        try:
+            x = float(p)
+        except (TypeError, ValueError):
+            out.append(None)
+            continue
+        out.append(x if math.isfinite(x) else None)
+    return out
 
 
 class _Extracted:
@@ -227,333 +270,3 @@ class _Extracted:
 _EXTRACTED = _Extracted()
 atexit.register(_EXTRACTED.cleanup)
 
-
-# FMI 2.0 log messages are variadic; fmpy formats them with a native proxy that forwards to
-# ONE process-wide Python logger (a C global set by ``addLoggerProxy``). That logger must
-# therefore live forever: this module's dispatcher, which hands each message to the unit
-# whose componentEnvironment it carries, and prints the others as fmpy would.
-_FMI2_UNITS: dict[int, weakref.ref] = {}
-_FMI2_IDS = itertools.count(1)
-_FMI2_CALLBACKS: Any = None
-
-
-def _fmi2_dispatch(env: Any, name: Any, status: int, category: Any, message: Any) -> None:
-    ref = _FMI2_UNITS.get(int(env or 0))
-    unit = ref() if ref is not None else None
-    if unit is None:
-        from fmpy.fmi1 import printLogMessage
-
-        printLogMessage(env, name, status, category, message)
-        return
-    unit._log(status, category, message)
-
-
-def _fmi2_callbacks(unit_id: int) -> Any:
-    """A callback structure whose logger reaches :func:`_fmi2_dispatch` with ``unit_id``."""
-    global _FMI2_CALLBACKS
-    from fmpy import calloc, free
-    from fmpy.fmi2 import (
-        fmi2CallbackAllocateMemoryTYPE,
-        fmi2CallbackFreeMemoryTYPE,
-        fmi2CallbackFunctions,
-        fmi2CallbackLoggerTYPE,
-    )
-    from fmpy.logging import addLoggerProxy
-
-    if _FMI2_CALLBACKS is None:      # created once, never freed
-        _FMI2_CALLBACKS = (fmi2CallbackLoggerTYPE(_fmi2_dispatch),
-                           fmi2CallbackAllocateMemoryTYPE(calloc),
-                           fmi2CallbackFreeMemoryTYPE(free))
-    cb = fmi2CallbackFunctions()
-    cb.logger, cb.allocateMemory, cb.freeMemory = _FMI2_CALLBACKS
-    cb.componentEnvironment = unit_id
-    addLoggerProxy(ctypes.byref(cb))   # cb.logger := proxy; the proxy's target := dispatcher
-    return cb
-
-
-class _Unit:
-    """Common part of the co-simulation units (one FMU instance)."""
-
-    interface = ""
-
-    def __init__(self, name: str, info: FmuInfo, input_names: list[str],
-                 output_names: list[str]) -> None:
-        self.name = name
-        self.info = info
-        self.input_names = list(input_names)
-        self.output_names = list(output_names)
-        self.fmu: Any = None
-        self._vr_u = [info.variables[n].vr for n in input_names]
-        self._vr_y = [info.variables[n].vr for n in output_names]
-        self._u_vr = (ctypes.c_uint32 * len(self._vr_u))(*self._vr_u)
-        self._y_vr = (ctypes.c_uint32 * len(self._vr_y))(*self._vr_y)
-        self._u_buf = np.zeros(len(self._vr_u))
-        self._y_buf = np.zeros(len(self._vr_y))
-        self.time = 0.0
-        # (status, category, message) logged by the FMU; the last errors go into exceptions
-        self.messages: collections.deque[tuple[int, str, str]] = collections.deque(maxlen=50)
-        self._callbacks: Any = None
-        self._n_logged = 0
-
-    # fast real access with preallocated buffers ---------------------------------------------
-    def _set(self, vr_arr: Any, values: np.ndarray) -> None:
-        if len(values) == 0:
-            return
-        buf = np.ascontiguousarray(values, dtype=float)
-        ptr = buf.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
-        if self.info.fmi_version == 2:
-            self.fmu.fmi2SetReal(self.fmu.component, vr_arr, len(buf), ptr)
-        else:
-            self.fmu.fmi3SetFloat64(self.fmu.component, vr_arr, len(buf), ptr, len(buf))
-
-    def _get(self, vr_arr: Any, out: np.ndarray) -> np.ndarray:
-        if len(out) == 0:
-            return out
-        ptr = out.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
-        if self.info.fmi_version == 2:
-            self.fmu.fmi2GetReal(self.fmu.component, vr_arr, len(out), ptr)
-        else:
-            self.fmu.fmi3GetFloat64(self.fmu.component, vr_arr, len(out), ptr, len(out))
-        return out
-
-    def set_inputs(self, values: np.ndarray) -> None:
-        """Set all inputs (in ``input_names`` order)."""
-        self._call(self._set, self._u_vr, values)
-
-    def get_outputs(self) -> np.ndarray:
-        """All outputs (in ``output_names`` order), a fresh array."""
-        return self._call(self._get, self._y_vr, self._y_buf).copy()
-
-    def get(self, names: list[str]) -> np.ndarray:
-        """Values of any real variables by name (locals, states, parameters...)."""
-        vrs = [self.info.variable(n, self.name).vr for n in names]
-        arr = (ctypes.c_uint32 * len(vrs))(*vrs)
-        return self._call(self._get, arr, np.zeros(len(vrs)))
-
-    def set_real(self, values: dict[str, float]) -> None:
-        if not values:
-            return
-        vrs = [self.info.variable(n, self.name).vr for n in values]
-        arr = (ctypes.c_uint32 * len(vrs))(*vrs)
-        self._call(self._set, arr, np.array([float(v) for v in values.values()]))
-
-    def _log(self, status: int, category: Any, message: Any) -> None:
-        def text(b: Any) -> str:
-            return b.decode("utf-8", "replace") if isinstance(b, bytes) else str(b or "")
-        self.messages.append((int(status), text(category), text(message)))
-        self._n_logged += 1
-
-    def fmu_errors(self) -> list[str]:
-        """The messages the FMU logged with status Discard, Error or Fatal."""
-        return [m for status, _, m in self.messages if status >= 2]
-
-    def _call(self, fn: Any, *args: Any, **kw: Any) -> Any:
-        n_before = self._n_logged
-        try:
-            return fn(*args, **kw)
-        except CosimStepError:
-            raise
-        except Exception as err:
-            new = min(self._n_logged - n_before, len(self.messages))
-            said = [m for status, _, m in list(self.messages)[len(self.messages) - new:]
-                    if status >= 2]
-            detail = f"{err}" + (f" -- the FMU says: {' | '.join(said[-2:])}" if said else "")
-            raise CosimStepError(f"element {self.name!r} ({self.info.path.name}): FMU call "
-                                 f"failed at t={self.time:g}: {_one_line(detail, 600)}",
-                                 self.name, self.time) from err
-
-    def _instantiate(self, slave: bool) -> None:
-        from fmpy import fmi2, fmi3
-
-        unzip = str(_EXTRACTED.get(self.info.path))
-        ident = self.info.cs_identifier if slave else self.info.me_identifier
-        if ident is None:
-            raise SetupError(f"element {self.name!r}: {self.info.path.name} has no "
-                             f"{'Co-Simulation' if slave else 'Model Exchange'} interface")
-        kw = dict(unzipDirectory=unzip, modelIdentifier=ident, instanceName=self.name)
-        if self.info.fmi_version == 2:
-            cls = fmi2.FMU2Slave if slave else fmi2.FMU2Model
-        elif self.info.fmi_version == 3:
-            cls = fmi3.FMU3Slave if slave else fmi3.FMU3Model
-        else:
-            raise SetupError(f"element {self.name!r}: FMI {self.info.fmi_version} is not "
-                             "supported (FMI 2.0 and 3.0 are)")
-        try:
-            self.fmu = cls(guid=self.info.guid, **kw)  # fmpy: the FMI 3 token goes as guid
-        except Exception as err:  # no binary for this platform, unloadable library...
-            raise SetupError(f"element {self.name!r}: cannot load the binary of "
-                             f"{self.info.path.name}: {_one_line(err)}") from None
-        if self.info.fmi_version == 2:
-            unit_id = next(_FMI2_IDS)
-            _FMI2_UNITS[unit_id] = weakref.ref(self)
-            self._fmi2_id = unit_id
-            self._callbacks = _fmi2_callbacks(unit_id)   # the FMU keeps a pointer to it
-            self._call(self.fmu.instantiate, callbacks=self._callbacks)
-        else:
-            ref = weakref.ref(self)
-
-            def log3(env: Any, status: int, category: Any, message: Any) -> None:
-                unit = ref()
-                if unit is not None:
-                    unit._log(status, category, message)
-
-            self._callbacks = log3                # fmpy keeps it as fmu.logMessage too
-            self._call(self.fmu.instantiate, logMessage=log3)
-
-    def terminate(self) -> None:
-        if self.fmu is None:
-            return
-        try:
-            self.fmu.terminate()
-        except Exception:  # noqa: BLE001 - best effort on shutdown
-            pass
-        try:
-            self.fmu.freeInstance()
-        except Exception:  # noqa: BLE001
-            pass
-        self.fmu = None
-        _FMI2_UNITS.pop(getattr(self, "_fmi2_id", -1), None)
-
-
-class CoSimUnit(_Unit):
-    """A Co-Simulation FMU instance stepped by its own solver."""
-
-    interface = "cs"
-
-    def setup(self, start: float, stop: float, parameters: dict[str, float],
-              inputs: np.ndarray, tolerance: float | None = None) -> None:
-        self._instantiate(slave=True)
-        fmu = self.fmu
-        self.time = start
-        if self.info.fmi_version == 2:
-            self._call(fmu.setupExperiment, tolerance, start, stop)
-            self.set_real(parameters)
-            self.set_inputs(inputs)
-            self._call(fmu.enterInitializationMode)
-        else:
-            self.set_real(parameters)
-            self.set_inputs(inputs)
-            self._call(fmu.enterInitializationMode, tolerance, start, stop)
-        self._call(fmu.exitInitializationMode)
-
-    def step(self, t: float, h: float, u0: np.ndarray, slope: np.ndarray | None = None) -> None:
-        """Advance from ``t`` to ``t + h`` with the inputs ``u0 + slope (s - t)``, held at
-        their mean over the step (``u0 + slope h / 2``)."""
-        u = u0 if slope is None else u0 + 0.5 * h * slope
-        self.set_inputs(u)
-        self.time = t
-        self._call(self.fmu.doStep, t, h)
-        self.time = t + h
-
-
-class ModelExchangeUnit(_Unit):
-    """A Model Exchange FMU instance integrated by the master (SciPy Radau)."""
-
-    interface = "me"
-
-    def __init__(self, *args: Any, rtol: float = 1e-8, atol: float = 1e-10, **kw: Any) -> None:
-        super().__init__(*args, **kw)
-        self.rtol = rtol
-        self.atol = atol
-        self.nx = self.info.n_states
-        self.x = np.zeros(self.nx)
-        self.dx = np.zeros(self.nx)
-        self._h_last: float | None = None
-        self.n_rhs = 0
-
-    def setup(self, start: float, stop: float, parameters: dict[str, float],
-              inputs: np.ndarray, tolerance: float | None = None) -> None:
-        self._instantiate(slave=False)
-        fmu = self.fmu
-        self.time = start
-        if self.info.fmi_version == 2:
-            self._call(fmu.setupExperiment, tolerance, start, stop)
-            self.set_real(parameters)
-            self.set_inputs(inputs)
-            self._call(fmu.enterInitializationMode)
-            self._call(fmu.exitInitializationMode)
-            while True:   # event iteration at the initial time
-                if not self._call(fmu.newDiscreteStates)[0]:
-                    break
-            self._call(fmu.enterContinuousTimeMode)
-        else:
-            self.set_real(parameters)
-            self.set_inputs(inputs)
-            self._call(fmu.enterInitializationMode, tolerance, start, stop)
-            self._call(fmu.exitInitializationMode)
-            while True:
-                res = self._call(fmu.updateDiscreteStates)
-                if not res[0]:
-                    break
-            self._call(fmu.enterContinuousTimeMode)
-        self._get_states()
-
-    def _ptr(self, arr: np.ndarray) -> Any:
-        return arr.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
-
-    def _get_states(self) -> None:
-        if self.nx == 0:
-            return
-        self._call(self.fmu.getContinuousStates, self._ptr(self.x), self.nx)
-
-    def _set_state(self, t: float, x: np.ndarray) -> None:
-        self.fmu.setTime(t)
-        if self.nx:
-            xs = np.ascontiguousarray(x, dtype=float)
-            self.fmu.setContinuousStates(self._ptr(xs), self.nx)
-
-    def _rhs(self, t: float, x: np.ndarray, u0: np.ndarray, slope: np.ndarray | None,
-             t0: float) -> np.ndarray:
-        self._set_state(t, x)
-        self._set(self._u_vr, u0 if slope is None else u0 + slope * (t - t0))
-        out = np.empty(self.nx)
-        if self.info.fmi_version == 2:
-            self.fmu.getDerivatives(self._ptr(out), self.nx)
-        else:
-            self.fmu.getContinuousStateDerivatives(self._ptr(out), self.nx)
-        self.n_rhs += 1
-        return out
-
-    def step(self, t: float, h: float, u0: np.ndarray, slope: np.ndarray | None = None) -> None:
-        """Integrate from ``t`` to ``t + h`` with the inputs ``u0 + slope (s - t)``."""
-        from scipy.integrate import solve_ivp
-
-        self.time = t
-        if self.nx and h > 0:
-            first = None if self._h_last is None else min(self._h_last, h)
-            try:
-                sol = solve_ivp(self._rhs, (t, t + h), self.x, method="Radau",
-                                rtol=self.rtol, atol=self.atol, args=(u0, slope, t),
-                                first_step=first)
-            except CosimStepError:
-                raise
-            except Exception as err:
-                said = self.fmu_errors()[-1:]
-                detail = f"{err}" + (f" -- the FMU says: {said[0]}" if said else "")
-                raise CosimStepError(f"element {self.name!r}: integration failed at t={t:g}: "
-                                     f"{_one_line(detail, 600)}", self.name, t) from err
-            if not sol.success:
-                raise CosimStepError(f"element {self.name!r}: integration failed at t={t:g}: "
-                                     f"{sol.message}", self.name, t)
-            self.x = np.array(sol.y[:, -1])
-            steps = np.diff(sol.t)
-            if len(steps):
-                self._h_last = float(steps[-1]) if len(steps) == 1 else float(
-                    max(steps[-1], steps[-2]))
-        self._call(self._set_state, t + h, self.x)
-        end_inputs = u0 if slope is None else u0 + slope * h
-        self.set_inputs(end_inputs)
-        self.time = t + h
-        if not all(math.isfinite(v) for v in self.x):
-            raise CosimStepError(f"element {self.name!r}: states not finite at t={t + h:g}",
-                                 self.name, t + h)
-
-
-def make_unit(name: str, info: FmuInfo, interface: str, input_names: list[str],
-              output_names: list[str], *, rtol: float = 1e-8, atol: float = 1e-10) -> _Unit:
-    """A :class:`CoSimUnit` (``interface="cs"``) or :class:`ModelExchangeUnit` (``"me"``)."""
-    if interface == "cs":
-        return CoSimUnit(name, info, input_names, output_names)
-    if interface == "me":
-        return ModelExchangeUnit(name, info, input_names, output_names, rtol=rtol, atol=atol)
-    raise SetupError(f"element {name!r}: interface must be 'cs' or 'me', not {interface!r}")

@@ -61,8 +61,9 @@ from .errors import (
     SetupError,
     UnknownConnectorError,
 )
-from .fmu import FmuInfo, make_unit, read_fmu_info
+from .fmu import FmuInfo, read_fmu_info
 from .ssp import SystemStructure, read_ssp
+from .units import make_unit
 
 ORDERS = ("jacobi", "gauss-seidel")
 MAX_STEPS = 100_000_000              # macro steps of one run (1e8: hours of FMU calls)
@@ -154,6 +155,11 @@ class Master:
 
     def _interface(self, name: str, implementation: str, wanted: Any) -> str:
         info = self.infos[name]
+        if not info.cs_identifier and not info.me_identifier:
+            offers = ("only Scheduled Execution, which this master does not run (it runs "
+                      "Co-Simulation and Model Exchange FMUs)") if info.scheduled_execution \
+                else "neither Co-Simulation nor Model Exchange"
+            raise SetupError(f"element {name!r}: {info.path.name} offers {offers}")
         if isinstance(wanted, Mapping):
             wanted = wanted.get(name, "cs")
         if wanted == "auto":
@@ -320,6 +326,7 @@ class Master:
                 row += 1
 
             record_point(0, t0)
+            terminated: dict[str, Any] | None = None
             u_prev: dict[str, np.ndarray] | None = None
             wall1 = _time.perf_counter()
             for k in range(n_steps):
@@ -372,6 +379,13 @@ class Master:
                 if propagate:
                     propagate_outputs()
                 u_prev = u_now
+                stopped = [n for n in names if units[n].terminated]
+                if stopped:
+                    first = min(stopped, key=lambda n: units[n].time)
+                    terminated = {"element": first, "time": units[first].time,
+                                  "reason": units[first].stop_reason}
+                    record_point(n_steps, units[first].time)
+                    break
                 for n in names:
                     bad_mask = ~np.isfinite(y[n])
                     if max_abs is not None:
@@ -407,6 +421,9 @@ class Master:
             "sequence": seq if order == "gauss-seidel" else None,
             "setup_seconds": wall_setup, "run_seconds": wall_run,
             "seconds_per_simulated_second": wall_run / span,
+            "terminated": terminated,
+            "events": {n: list(u.event_times) for n, u in units.items()
+                       if self.interfaces[n] == "me"},
             "me_rhs_evaluations": {n: getattr(u, "n_rhs", None) for n, u in units.items()
                                    if self.interfaces[n] == "me"},
         }

@@ -174,7 +174,7 @@ def test_connection_into_a_parameter(tanks):
     ("A", math.nan, r"tank1\.A: the value nan is not finite"),
     ("A", math.inf, r"tank1\.A: the value inf is not finite"),
     ("A", "abc", r"tank1\.A: 'abc' is not a number"),
-    ("level", 1.0, r"tank1\.level: it is a continuous output Real of Tank\.fmu, not a real "
+    ("level", 1.0, r"tank1\.level: it is a continuous output Real of Tank\.fmu, not a "
                    "parameter that can be set"),
     ("h", 1.0, r"tank1\.h: it is a continuous local Real"),
     ("time", 1.0, r"tank1\.time: it is a continuous independent Real"),
@@ -206,9 +206,13 @@ def test_constant_and_calculated_parameters_are_not_settable(tmp_path):
             check_parameter_value("x", info, "p", 1.0)
     info = FmuInfo(tmp_path / "X.fmu", "X", 2, "", {"p": var("parameter", "fixed")}, {})
     assert check_parameter_value("x", info, "p", "1.5") == 1.5
-    info.variables["p"].type = "Integer"
-    with pytest.raises(InvalidParameterError, match="Integer"):
-        check_parameter_value("x", info, "p", 1)
+    info.variables["p"].type = "Integer"          # typed parameters are set as such
+    assert check_parameter_value("x", info, "p", 1) == 1.0
+    with pytest.raises(InvalidParameterError, match="1.5 is not an integer"):
+        check_parameter_value("x", info, "p", 1.5)
+    info.variables["p"].type = info.variables["p"].fmi_type = "UInt8"
+    with pytest.raises(InvalidParameterError, match=r"outside the UInt8 range \[0, 255\]"):
+        check_parameter_value("x", info, "p", -1)
 
 
 @pytest.mark.parametrize("kw, message", [
@@ -402,7 +406,7 @@ def test_cli_broken_archives(main, tanks, tmp_path, capsys):
     (["--stop-time", "1e300"], "InvalidExperimentError", "needs 1e+302 macro steps"),
     (["--set", "tank1.A=50"], "InvalidParameterError", "tank1.A = 50 is outside the range"),
     (["--set", "tank1.A=nan"], "ParameterError", "'nan' is not finite"),
-    (["--set", "tank1.level=1"], "InvalidParameterError", "not a real parameter"),
+    (["--set", "tank1.level=1"], "InvalidParameterError", "not a parameter that can be set"),
     (["--set", "tank3.A=1"], "UnknownConnectorError", "unknown element 'tank3'"),
     (["--record", "tank1.nope"], "UnknownConnectorError", "no variable 'nope'"),
     (["-o", "missing/dir/out.csv"], "CosimError", "the folder missing/dir does not exist"),
