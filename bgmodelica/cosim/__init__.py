@@ -38,6 +38,7 @@ from .errors import (
     UnsafeArchiveError,
 )
 from .master import Master, cosimulate
+from .single import simulate_fmu
 from .ssp import (
     SspComponent,
     SspConnection,
@@ -55,7 +56,7 @@ __all__ = [
     "CosimStepError", "DuplicateElementError", "FmuFormatError", "InvalidExperimentError",
     "InvalidParameterError", "SafeZip", "SetupError", "SspFormatError",
     "UnconnectedInputError", "UnknownConnectorError", "UnsafeArchiveError",
-    "Master", "cosimulate", "SspComponent", "SspConnection", "SspConnector",
+    "Master", "cosimulate", "simulate_fmu", "SspComponent", "SspConnection", "SspConnector",
     "SystemStructure", "read_ssp", "system_from_fmus", "write_ssp", "VerificationReport",
     "verify_model", "FlowInput", "FlowOutput", "PotentialInput", "PotentialOutput",
     "add_signal", "expose",

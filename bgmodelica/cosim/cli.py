@@ -127,6 +127,38 @@ def cmd_cosim(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_simulate_fmu(args: argparse.Namespace) -> int:
+    """``bgmodelica simulate-fmu``: one FMU through the master, results to CSV."""
+    from .single import simulate_fmu
+
+    for value, what in ((args.stop_time, "--stop-time"), (args.interval, "--interval")):
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise InvalidExperimentError(f"{what} must be a finite number > 0, got {value}")
+    sets = {}
+    for item in args.set:
+        name, sep, value = item.partition("=")
+        if not sep or not name.strip():
+            raise CosimError(f"--set {item!r}: expected NAME=VALUE")
+        sets[name.strip()] = value.strip()
+    out_arg = _writable(args.output, "output file")
+    res = simulate_fmu(args.fmu, stop_time=args.stop_time, interval=args.interval,
+                       parameters=sets, inputs=args.input, interface=args.interface,
+                       rtol=args.rtol, atol=args.atol, record=args.record)
+    out = out_arg or _writable(f"{res.meta['model']}.csv", "output file")
+    assert out is not None
+    _write_atomically(out, res.to_csv, "output file")
+    meta = res.meta
+    (kind,) = set(meta["interfaces"].values())
+    print(f"{meta['model']}: {'Model Exchange' if kind == 'me' else 'Co-Simulation'}, "
+          f"{len(res.time)} points to t = {float(res.time[-1]):g} s, run "
+          f"{meta['run_seconds']:.3f} s -> {out}")
+    if meta.get("events"):
+        print(f"events: {len(meta['events'])} (first at t = {meta['events'][0]:.10g} s)")
+    if meta.get("terminated"):
+        print(f"note: {meta['terminated']['reason']} at t = {meta['terminated']['time']:g} s")
+    return 0
+
+
 def _steps(text: str) -> list[float]:
     try:
         steps = [float(s) for s in text.split(",") if s.strip()]
@@ -208,6 +240,28 @@ def register(sub: Any, model_args: Any = None) -> None:
     cos.add_argument("--plot", help="PNG with the first element's connectors (or --plot-vars)")
     cos.add_argument("--plot-vars", nargs="+", help="variables to plot")
     cos.set_defaults(func=cmd_cosim)
+
+    one = sub.add_parser("simulate-fmu", help="simulate one FMU (FMI 2.0/3.0, CS or ME with "
+                                              "events) and write a CSV")
+    one.add_argument("fmu", help="the .fmu file")
+    one.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                     help="a parameter or input start value (any type)")
+    one.add_argument("--input", metavar="CSV",
+                     help="input signals: a 'time' column, then one column per input")
+    one.add_argument("--stop-time", type=float, default=None,
+                     help="[s] (default: the FMU's DefaultExperiment, else 1)")
+    one.add_argument("--interval", type=float, default=None,
+                     help="output and communication interval [s] (default: the FMU's step "
+                          "size, else 1/500 of the horizon)")
+    one.add_argument("--interface", choices=["cs", "me", "auto"], default="auto",
+                     help="Co-Simulation (the FMU's solver) or Model Exchange (the master's "
+                          "integrator with event location); auto: CS when available")
+    one.add_argument("--rtol", type=float, default=1e-8, help="Model Exchange rtol")
+    one.add_argument("--atol", type=float, default=1e-10, help="Model Exchange atol")
+    one.add_argument("--record", nargs="+", metavar="VAR",
+                     help="variables to record besides the outputs (default: the states)")
+    one.add_argument("-o", "--output", help="CSV file (default <model>.csv)")
+    one.set_defaults(func=cmd_simulate_fmu)
 
     ver = sub.add_parser("verify", help="a model vs the co-simulation of its parts (SSP): "
                                         "errors, convergence order, --tolerance check")

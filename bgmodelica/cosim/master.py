@@ -183,7 +183,8 @@ class Master:
                  parameters: Mapping[str, Mapping[str, float]] | None = None,
                  record: Iterable[str] = (), tolerance: float | None = None,
                  record_every: int = 1, max_abs: float | None = None,
-                 max_steps: int | None = None) -> Result:
+                 max_steps: int | None = None,
+                 inputs: Mapping[str, tuple[Any, Any]] | None = None) -> Result:
         """Run the co-simulation and return the :class:`~bgmodelica.Result`.
 
         ``stop_time``/``step``: default from the SSD (DefaultExperiment, the master
@@ -194,6 +195,9 @@ class Master:
         ``max_abs``: stop with :class:`~.errors.CosimStepError` as soon as a coupled output
         exceeds this magnitude (an unstable coupling; None: only non-finite values stop).
         ``max_steps``: refuse runs with more macro steps (default :data:`MAX_STEPS`).
+        ``inputs``: ``{"element.input": (times, values)}`` signals for unconnected inputs
+        (linear between breakpoints, a repeated time is a jump, the end values held); within
+        a macro step they ramp from their value at its start to the one at its end.
         """
         system = self.system
         order = _norm_order(order)
@@ -265,6 +269,11 @@ class Master:
             start_u[n] = np.array(su, dtype=float)
         has_feed = {n: any(plan.feedthrough[n].get(y) for y in plan.outputs[n])
                     for n in names}
+        signals = _input_signals(inputs or {}, plan, src_index)
+        for n, given in signals.items():
+            for j, f in given:
+                start_u[n][j] = f(t0)
+        t_now = [t0]                    # the time the coupled inputs are evaluated at
 
         units = {}
         wall0 = _time.perf_counter()
@@ -285,6 +294,8 @@ class Master:
                 for j, s in enumerate(src_index[n]):
                     if s is not None:
                         u[j] = ys[s[0]][s[1]]
+                for j, f in signals.get(n, ()):
+                    u[j] = f(t_now[0])
                 return u
 
             def propagate_outputs() -> None:
@@ -331,12 +342,17 @@ class Master:
             wall1 = _time.perf_counter()
             for k in range(n_steps):
                 t = t0 + k * h
+                t_now[0] = t
                 u_now = {n: coupled(n, y) for n in names}
                 if order == "jacobi":
                     for n in names:
                         slope = None
                         if extrapolation and u_prev is not None and len(u_now[n]):
                             slope = (u_now[n] - u_prev[n]) / h
+                        if n in signals:
+                            slope = np.zeros(len(u_now[n])) if slope is None else slope
+                            for j, f in signals[n]:
+                                slope[j] = (f(t + h, True) - u_now[n][j]) / h
                         units[n].step(t, h, u_now[n], slope)
                         last_set[n] = u_now[n] if slope is None else None
                     y = {n: units[n].get_outputs() for n in names}
@@ -359,6 +375,11 @@ class Master:
                                 slope[j] = (u_now[n][j] - u_prev[n][j]) / h
                             elif not extrapolation:
                                 u0[j] = y[s[0]][s[1]]   # the newest value there is
+                        if n in signals:
+                            slope = np.zeros_like(u0) if slope is None else slope
+                            for j, f in signals[n]:
+                                u0[j] = f(t)
+                                slope[j] = (f(t + h, True) - u0[j]) / h
                         units[n].step(t, h, u0, slope)
                         last_set[n] = u0 if slope is None else None
                         y[n] = units[n].get_outputs()
@@ -373,6 +394,7 @@ class Master:
                         fresh[n] = np.array([all(fresh_in.get(u, True)
                                                  for u in plan.feedthrough[n].get(yn, []))
                                              for yn in plan.outputs[n]], dtype=bool)
+                t_now[0] = t + h
                 for n in names:
                     if last_set[n] is None:
                         last_set[n] = np.full(len(u_now[n]), np.nan)
@@ -436,3 +458,45 @@ def cosimulate(system: SystemStructure | str | Path, stop_time: float | None = N
                **options: Any) -> Result:
     """One-call form: ``Master(system, interface=...).simulate(stop_time, step, **options)``."""
     return Master(system, interface=interface).simulate(stop_time, step, **options)
+
+
+def _signal(times: np.ndarray, values: np.ndarray) -> Any:
+    """f(t): linear between breakpoints, a repeated time a jump (the later value from that
+    instant), the first/last value held outside. A macro step [t, t+h] ramps from f(t) to
+    the left limit f(t+h-), so a jump on the communication grid is taken exactly."""
+    last = len(times) - 1
+
+    def f(t: float, left: bool = False) -> float:
+        """The value at ``t``; ``left``: the limit from the left (before a jump at t)."""
+        k = int(np.searchsorted(times, t, side="left" if left else "right")) - 1
+        if k < 0:
+            return float(values[0])
+        if k >= last:
+            return float(values[last])
+        t0, t1 = times[k], times[k + 1]
+        return float(values[k] + (values[k + 1] - values[k]) * (t - t0) / (t1 - t0))
+
+    return f
+
+
+def _input_signals(inputs: Mapping[str, tuple[Any, Any]], plan: Plan,
+                   src_index: Mapping[str, list]) -> dict[str, list[tuple[int, Any]]]:
+    """element -> [(input position, f(t))] for the unconnected inputs given signals."""
+    out: dict[str, list[tuple[int, Any]]] = {}
+    for full, (times, values) in inputs.items():
+        el, _, name = full.partition(".")
+        if el not in plan.inputs or name not in plan.inputs[el]:
+            known = [f"{e}.{u}" for e in plan.inputs for u in plan.inputs[e]]
+            raise UnknownConnectorError(f"input signal {full!r}: no such input (inputs: "
+                                        f"{', '.join(known) or 'none'})")
+        j = plan.inputs[el].index(name)
+        if src_index[el][j] is not None:
+            raise SetupError(f"input signal {full!r}: the input is connected to an output")
+        t_arr = np.asarray(times, dtype=float).ravel()
+        v_arr = np.asarray(values, dtype=float).ravel()
+        if t_arr.size == 0 or t_arr.size != v_arr.size or np.any(np.diff(t_arr) < 0) \
+                or not (np.all(np.isfinite(t_arr)) and np.all(np.isfinite(v_arr))):
+            raise InvalidExperimentError(f"input signal {full!r}: needs as many finite times "
+                                         "(non-decreasing) as values")
+        out.setdefault(el, []).append((j, _signal(t_arr, v_arr)))
+    return out

@@ -170,7 +170,7 @@ class ModelExchangeUnit(_Unit):
             self._call(action)
         self._iterate()
         self._get_states()
-        self.event_times.append(self.time)
+        self.event_times.append(float(self.time))
 
     def _request_stop(self, why: str) -> None:
         self.terminated = True
