@@ -106,7 +106,8 @@ class PortAccess:
         self._groups = [(kind, g["vrs"], g["n"], np.array(g["take"], dtype=int),
                          np.array(g["put"], dtype=int), kind == "Boolean")
                         for kind, g in groups.items()]
-        self._fast = (len(self._groups) == 1 and self._groups[0][0] in ("Real", "Float64")
+        self._fast = (all(v.array_size == 1 for v in self.variables)
+                      and len(self._groups) == 1 and self._groups[0][0] in ("Real", "Float64")
                       and self._groups[0][2] == self.size
                       and np.array_equal(self._groups[0][3], np.arange(self.size)))
 

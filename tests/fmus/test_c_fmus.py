@@ -1,0 +1,150 @@
+"""The C test FMUs: valid for fmpy and fmutool, correct under fmpy (ME and CS), and run by
+our master with the same results - every FMI 3.0 type, arrays, a resource file, time events
+and a terminate request."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from fmpy import simulate_fmu as fmpy_simulate
+from fmpy.validation import validate_fmu
+from scipy.linalg import expm
+
+from bgmodelica.cosim.errors import ConnectorMismatchError, CosimStepError
+from bgmodelica.cosim.fmu import read_fmu_info
+from bgmodelica.cosim.master import Master
+from bgmodelica.cosim.single import simulate_fmu
+from bgmodelica.cosim.ssp import system_from_fmus
+
+A = np.array([0, 1, 0, -2, -0.5, 0, 0, 0, -3.0]).reshape(3, 3)
+X0 = np.array([1.0, 0.0, 0.5])
+INTERFACES = {"me": "ModelExchange", "cs": "CoSimulation"}
+
+
+def _fmutool() -> str | None:
+    exe = Path(sys.executable).with_name("fmutool")
+    return str(exe) if exe.exists() else shutil.which("fmutool")
+
+
+@pytest.mark.parametrize("name", ["Feedthrough", "StateSpace", "Resource", "Countdown"])
+def test_valid_for_fmpy_and_fmutool(c_fmus, name):
+    assert validate_fmu(str(c_fmus[name])) == []
+    tool = _fmutool()
+    if tool is None:
+        pytest.skip("fmutool (fmu-manipulation-toolbox) not installed")
+    run = subprocess.run([tool, "-input", str(c_fmus[name]), "-check"], capture_output=True,
+                         text=True, check=False)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "No semantic error" in run.stdout + run.stderr
+
+
+def test_arrays_are_listed_as_elements(c_fmus):
+    info = read_fmu_info(c_fmus["StateSpace"])
+    assert info.n_states == 3
+    assert [n for n in info.variables if n.startswith("A[")][:4] == ["A[1,1]", "A[1,2]",
+                                                                      "A[1,3]", "A[2,1]"]
+    a12 = info.variables["A[1,2]"]
+    assert (a12.array_size, a12.element, a12.start) == (9, 1, 1.0)
+    assert info.variables["u[3]"].causality == "input"
+    assert info.variables["m"].fmi_type == "UInt64"
+
+
+@pytest.mark.parametrize("interface", ["me", "cs"])
+def test_state_space_against_the_matrix_exponential(c_fmus, interface):
+    path = c_fmus["StateSpace"]
+    ours = simulate_fmu(path, stop_time=2.0, interval=0.05, interface=interface, rtol=1e-10,
+                        atol=1e-12)
+    exact = np.array([expm(A * t) @ X0 for t in ours.time])
+    ref = fmpy_simulate(str(path), fmi_type=INTERFACES[interface], stop_time=2.0,
+                        output_interval=0.05, relative_tolerance=1e-10)
+    for i in range(3):
+        span = np.ptp(exact[:, i])
+        assert np.max(np.abs(ours[f"y[{i + 1}]"] - exact[:, i])) < 1e-6 * span
+        assert np.max(np.abs(ours[f"y[{i + 1}]"] - ref["y"][:, i])) < 1e-6 * span
+
+
+def test_state_space_array_input_from_a_table(c_fmus):
+    """u = (1, 0, 0) from t = 0: x(t) = e^{At} x0 + A^-1 (e^{At} - I) B u (B = I)."""
+    u = np.array([1.0, 0.0, 0.0])
+    res = simulate_fmu(c_fmus["StateSpace"], stop_time=1.0, interval=0.05, interface="me",
+                       inputs={"u[1]": ([0.0, 1.0], [1.0, 1.0])}, rtol=1e-10, atol=1e-12)
+    for k, t in enumerate(res.time):
+        e = expm(A * t)
+        x = e @ X0 + np.linalg.solve(A, (e - np.eye(3)) @ u)
+        assert np.allclose([res[f"x[{i}]"][k] for i in (1, 2, 3)], x, atol=1e-8)
+    assert np.all(res["u[1]"] == 1.0) and np.all(res["u[2]"] == 0.0)
+
+
+@pytest.mark.parametrize("interface", ["me", "cs"])
+def test_every_type_is_fed_through(c_fmus, interface):
+    values = {"Float32_continuous_input": 0.1, "Float64_continuous_input": -2.5,
+              "Float64_discrete_input": 7.25, "Int8_input": -128, "UInt8_input": 255,
+              "Int16_input": -32768, "UInt16_input": 65535, "Int32_input": -2**31,
+              "UInt32_input": 2**32 - 1, "Int64_input": -2**53, "UInt64_input": 2**53,
+              "Boolean_input": True, "Enumeration_input": 2,
+              "String_input": "héllo", "Binary_input": b"\x00\xffab",
+              "Float64_tunable_parameter": 5.0}
+    res = simulate_fmu(c_fmus["Feedthrough"], stop_time=0.2, interval=0.1,
+                       interface=interface, parameters=values)
+    for name, v in values.items():
+        if name.endswith("_input") and not name.startswith(("String", "Binary")):
+            out = name.replace("_input", "_output")
+            expect = float(np.float32(v)) if name.startswith("Float32") else float(v)
+            assert res[out][-1] == expect, out
+    assert res["Float64_parameter_sum"][-1] == 6.0
+    with pytest.raises(Exception, match=r"Int8_input: 200 is outside the Int8 range"):
+        simulate_fmu(c_fmus["Feedthrough"], parameters={"Int8_input": 200})
+
+
+def test_typed_connections_between_fmus(c_fmus):
+    """Two Feedthrough FMUs in a chain: every numeric and Boolean output drives the other's
+    input with its own type; String/Binary cannot be connected."""
+    path = c_fmus["Feedthrough"]
+    kinds = ["Float32_continuous", "Float64_continuous", "Float64_discrete", "Int8", "UInt8",
+             "Int16", "UInt16", "Int32", "UInt32", "Int64", "UInt64", "Boolean", "Enumeration"]
+    conns = [("a", f"{k}_output", "b", f"{k}_input") for k in kinds]
+    system = system_from_fmus("chain", {"a": path, "b": path}, conns)
+    given = {"Int8_input": -7, "UInt16_input": 40000, "Boolean_input": 1, "Enumeration_input": 2,
+             "Int64_input": 2**40, "Float32_continuous_input": 1.5}
+    for interface in ("cs", "me"):
+        res = Master(system, interface=interface, allow_unconnected=True).simulate(
+            0.3, 0.1, parameters={"a": given})
+        for name, v in given.items():
+            assert res[f"b.{name.replace('_input', '_output')}"][-1] == v
+    bad = system_from_fmus("bad", {"a": path, "b": path},
+                           [("a", "String_output", "b", "String_input")])
+    with pytest.raises(ConnectorMismatchError, match="String variables cannot be connected"):
+        Master(bad, allow_unconnected=True)
+
+
+@pytest.mark.parametrize("interface", ["me", "cs"])
+def test_resource_file_is_read(c_fmus, interface, tmp_path):
+    res = simulate_fmu(c_fmus["Resource"], interface=interface)
+    assert np.all(res["y"] == ord("A"))
+    assert fmpy_simulate(str(c_fmus["Resource"]), fmi_type=INTERFACES[interface])["y"][-1] == 65
+    # the same FMU without its resource file: a clear error with the FMU's own message
+    broken = tmp_path / "Resource.fmu"
+    with zipfile.ZipFile(c_fmus["Resource"]) as src, zipfile.ZipFile(broken, "w") as dst:
+        for item in src.infolist():
+            if not item.filename.startswith("resources/"):
+                dst.writestr(item, src.read(item))
+    with pytest.raises(CosimStepError, match=r"cannot open the resource file .*y\.txt"):
+        simulate_fmu(broken, interface=interface)
+
+
+@pytest.mark.parametrize("interface", ["me", "cs"])
+def test_terminate_request_ends_the_run(c_fmus, interface):
+    res = simulate_fmu(c_fmus["Countdown"], stop_time=5.0, interval=0.25, interface=interface)
+    assert res.time[-1] == pytest.approx(3.0)
+    assert res.meta["terminated"]["time"] == pytest.approx(3.0)
+    assert "terminate" in res.meta["terminated"]["reason"]
+    steps = res.time < 3.0 - 1e-9
+    assert np.array_equal(res["counter"][steps], 3 - np.floor(res.time[steps] + 1e-9))
+    assert res["counter"][-1] == 0
+    assert np.allclose(res["x"], res.time, atol=1e-9)
