@@ -206,6 +206,7 @@ def fmu_spec(model: Component | CompiledModel, *, stop_time: float = 1.0,
         init = _init_function(dae, p_all, t, u, p)
     return FmuSpec(model_name=name, description=f"{compiled.name} (bgmodelica)",
                    states=state_vars, inputs=inputs, parameters=params, outputs=outputs,
+                   state_outputs=[n for n in declared_outputs if n in states],
                    locals=locals_, ode=ode, init=init,
                    stop_time=stop_time,
                    step_size=step_size, tolerance=tolerance, hybrid=hyb_spec)

@@ -139,8 +139,9 @@ def _structure_entries(table: VariableTable, deps: Dependencies, has_init: bool)
         return sorted([states[i] for i in xs] + [inputs[i] for i in us]
                       + [params[i] for i in ps], key=lambda v: v.vr)
 
-    for o in outputs:
-        yield "output", o, ct(deps.outputs[o.index])
+    for o in sorted(outputs + [s for s in states if s.causality == "output"],
+                    key=lambda v: v.vr):
+        yield "output", o, [o] if o.kind == "state" else ct(deps.outputs[o.index])
     for d in derivs:
         yield "derivative", d, ct(deps.derivatives[d.index])
     initial: list[tuple[FmiVariable, list[FmiVariable]]] = []

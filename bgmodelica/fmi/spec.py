@@ -93,6 +93,8 @@ class FmuSpec:
     #: models with events: a :class:`bgmodelica.fmi.hybrid.HybridSpec`; then ``ode`` (and
     #: ``init``) take the discrete slots as their last argument ``(t, x, u, p, d)``
     hybrid: Any = None
+    #: names of states that are also outputs (exported with causality="output")
+    state_outputs: list[str] = field(default_factory=list)
 
     @property
     def nx(self) -> int:

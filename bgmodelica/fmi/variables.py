@@ -123,10 +123,12 @@ def build_table(spec: FmuSpec, with_solver: bool, with_indicators: bool = False
     add(None, "time", "time", 0, "independent", "continuous", None, None, "s")
     out[0].description = "Simulation time"
     state_vrs = []
+    state_outputs = set(spec.state_outputs)
     for i, s in enumerate(spec.states):
         initial = "calculated" if spec.init is not None else "exact"
         start = None if spec.init is not None else float(s.start)
-        var = add(s, s.name, "state", i, "local", "continuous", initial, start, s.unit,
+        causality = "output" if s.name in state_outputs else "local"
+        var = add(s, s.name, "state", i, causality, "continuous", initial, start, s.unit,
                   min=_opt(s.min), max=_opt(s.max), nominal=_opt(s.nominal))
         state_vrs.append(var.vr)
     for i, s in enumerate(spec.states):
