@@ -256,7 +256,8 @@ def register(sub: Any, model_args: Any = None) -> None:
     one.add_argument("--interface", choices=["cs", "me", "auto"], default="auto",
                      help="Co-Simulation (the FMU's solver) or Model Exchange (the master's "
                           "integrator with event location); auto: CS when available")
-    one.add_argument("--rtol", type=float, default=1e-8, help="Model Exchange rtol")
+    one.add_argument("--rtol", type=float, default=1e-8,
+                     help="Model Exchange rtol, and the FMU's experiment tolerance")
     one.add_argument("--atol", type=float, default=1e-10, help="Model Exchange atol")
     one.add_argument("--record", nargs="+", metavar="VAR",
                      help="variables to record besides the outputs (default: the states)")

@@ -4,9 +4,10 @@
 controlled with ``rtol``/``atol``), the inputs following the master's ramp. Within a macro
 step it
 
-* locates **state events** (a sign change of an event indicator) on the solver's dense
-  output with the Illinois method, to ``event_tol`` seconds, and stops right after the
-  crossing;
+* locates **state events** (a sign change of an event indicator) with the Illinois method,
+  to ``event_tol`` (relative) seconds, each trial state integrated from the step's start at
+  the unit's tolerances (not the dense output, whose error an indicator may amplify), and
+  stops right after the crossing;
 * stops exactly at **time events** (``nextEventTime``);
 * handles **step events** (``completedIntegratorStep`` asking for event mode);
 * iterates each event to a fixed point (``newDiscreteStates`` / ``updateDiscreteStates``),
@@ -17,6 +18,7 @@ step it
 from __future__ import annotations
 
 import ctypes
+import functools
 import math
 from typing import Any
 
@@ -178,8 +180,8 @@ class ModelExchangeUnit(_Unit):
 
     def _locate(self, dense: Any, ta: float, tb: float, za: np.ndarray, zb: np.ndarray,
                 args: tuple) -> float:
-        """The time just after the first crossing in ``(ta, tb]`` (Illinois on the dense
-        output, each indicator evaluated by the FMU)."""
+        """The time just after the first crossing in ``(ta, tb]`` (Illinois; ``dense(t)``
+        gives the state at t, the FMU the indicators)."""
         tol = self.event_tol * max(1.0, abs(tb))
         while tb - ta > tol:
             crossed = np.flatnonzero(_crossed(za, zb))
@@ -275,8 +277,12 @@ class ModelExchangeUnit(_Unit):
             if self.nz:
                 z_new = self._indicators(t_new, x_new, *args)
                 if _crossed(z_prev, z_new).any():
-                    te = self._locate(dense, t_old, t_new, z_prev, z_new, args)
-                    self.x = np.array(dense(te)) if self.nx else self.x
+                    x_old = self.x.copy()
+                    exact = functools.partial(self._state_at, t_old, x_old, fun=fun,
+                                              Radau=Radau) if self.nx else dense
+                    te = self._locate(exact, t_old, t_new, z_prev, z_new, args)
+                    self.x = np.array(x_new if te >= t_new else exact(te)) if self.nx \
+                        else self.x
                     self.time = te
                     self._call(self._set_state, te, self.x)
                     self._event()
@@ -296,6 +302,22 @@ class ModelExchangeUnit(_Unit):
             if solver is None or solver.status == "finished" or t_new >= t_stop:
                 return t_stop
             t_old = t_new
+
+    def _state_at(self, t0: float, x0: np.ndarray, t1: float, *, fun: Any,
+                  Radau: Any) -> np.ndarray:
+        """The state at ``t1`` integrated from ``(t0, x0)`` at the unit's tolerances (for
+        event location: the dense output is less accurate than the steps, and an event
+        indicator may amplify its error)."""
+        if not t1 > t0:
+            return np.array(x0)
+        span = t1 - t0
+        solver = Radau(fun, t0, x0, t1, rtol=self.rtol, atol=self.atol,
+                       first_step=min(self._h_last or span, span))
+        while solver.status == "running":
+            msg = solver.step()
+            if solver.status == "failed":
+                raise self._failure(t0, msg)
+        return np.array(solver.y)
 
     def _failure(self, t: float, err: Any) -> CosimStepError:
         said = self.fmu_errors()[-1:]

@@ -49,8 +49,9 @@ def simulate_fmu(fmu: str | Path, *, stop_time: float | None = None,
     ``parameters``: name -> value for parameters and input start values of any type.
     ``inputs``: CSV path or ``{name: (times, values)}``. ``interface``: ``"cs"``, ``"me"``
     (the master's integrator with events, tolerances ``rtol``/``atol``) or ``"auto"`` (CS
-    when the FMU has it). ``record``: variables to record besides the outputs (default: the
-    outputs and the continuous states).
+    when the FMU has it); ``rtol`` also goes to the FMU as its experiment tolerance (the
+    embedded solver of a Co-Simulation FMU may use it). ``record``: variables to record
+    besides the outputs (default: the continuous states).
     """
     info = read_fmu_info(fmu)
     md = info.description
@@ -77,7 +78,7 @@ def simulate_fmu(fmu: str | Path, *, stop_time: float | None = None,
         extra = [n for n, v in info.variables.items()
                  if (v.base or n) in state_names and v.causality not in ("output", "input")]
     else:
-        extra = list(record)
+        extra = [n for n in record if info.variable(n).causality != "output"]
     for name in extra:
         info.variable(name)
     system = system_from_fmus(info.model_name, {ELEMENT: info.path}, [])
@@ -87,7 +88,8 @@ def simulate_fmu(fmu: str | Path, *, stop_time: float | None = None,
                              parameters={ELEMENT: dict(parameters or {})},
                              record=[f"{ELEMENT}.{n}" for n in extra if info.variables[n].type
                                      not in ("String", "Binary")],
-                             inputs={f"{ELEMENT}.{k}": v for k, v in table.items()})
+                             inputs={f"{ELEMENT}.{k}": v for k, v in table.items()},
+                             tolerance=rtol)
     prefix = ELEMENT + "."
     columns = [n[len(prefix):] for n in result.names]
     meta = dict(result.meta)

@@ -333,3 +333,27 @@ def test_valgrind_bouncing_ball(build, tmp_path, version, fmu_type):
     assert "definitely lost" not in report or re.search(r"definitely lost: 0 bytes", report)
     assert "Invalid read" not in report and "Invalid write" not in report
     assert "driver done rc=0" in proc.stdout
+
+
+@pytest.mark.parametrize("model", EXAMPLES)
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("interface", ["me", "cs"])
+def test_hybrid_example_in_our_master(build, model, version, interface):
+    """The same FMUs run by bgmodelica's own master (``bgmodelica simulate-fmu``): Model
+    Exchange with its integrator and event location, Co-Simulation through doStep."""
+    from bgmodelica.cosim import simulate_fmu as master_simulate
+
+    fmu = build(model, version, interface)
+    _, stop, dt, names = _examples()[model]
+    nat = _native(model)
+    res = master_simulate(fmu, stop_time=stop, interval=dt, interface=interface, record=names,
+                          rtol=1e-10, atol=1e-12)
+    errors, compared = _errors(nat, res, names, dt)
+    assert compared >= 0.9 * (int(round(stop / dt)) + 1)
+    bad = {n: e for n, e in errors.items() if not e <= 1e-6}
+    assert not bad, f"{model} FMI {version} {interface}: {bad}"
+    if interface == "me":
+        native = np.asarray(nat.meta["event_times"], dtype=float)
+        ours = np.unique(np.round(np.asarray(res.meta["events"]), 12))
+        assert len(ours) == len(np.unique(np.round(native, 12)))
+        assert np.max(np.abs(ours - np.unique(np.round(native, 12)))) <= 1e-6
