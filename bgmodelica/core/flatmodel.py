@@ -187,6 +187,7 @@ class FlatTable:
     interpolation: str
     extrapolation: str
     origin: str
+    source: object = None   # (file path, column) of a table read from a file
 
 
 @dataclass

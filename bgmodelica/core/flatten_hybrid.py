@@ -227,7 +227,7 @@ def lower(draft: HybridDraft, slot_of: Callable[[Symbol], int],
             part.samples.append(FlatSample(slot_of(s), to_sx(s.start), to_sx(s.interval), ""))
         elif isinstance(s, TimeTable):
             part.tables.append(FlatTable(slot_of(s), slot_of(s.c1), s.times, s.values,
-                                         s.interpolation, s.extrapolation, ""))
+                                         s.interpolation, s.extrapolation, "", s.source))
         elif s is _INITIAL:
             part.initial = slot_of(s)
         elif s is _TERMINAL:

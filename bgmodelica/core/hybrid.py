@@ -32,6 +32,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -177,20 +178,54 @@ class TimeTable(_Special):
     """A table of ``values`` against ``times``: the expression ``c0 + c1*time`` whose
     coefficients change at the breakpoints (time events). See :func:`time_table`."""
 
-    __slots__ = ("times", "values", "interpolation", "extrapolation", "c1")
+    __slots__ = ("times", "values", "interpolation", "extrapolation", "c1", "source")
 
     def __init__(self, times: np.ndarray, values: np.ndarray, interpolation: str,
-                 extrapolation: str) -> None:
+                 extrapolation: str, source: tuple[str, str] | None = None) -> None:
         super().__init__("table.c0", Discrete(), None)
         self.c1 = _Special("table.c1", Discrete(), None)
         self.times = times
         self.values = values
         self.interpolation = interpolation
         self.extrapolation = extrapolation
+        self.source = source          # (file path, column) of a table read from a file
 
 
-def time_table(times: Sequence[float], values: Sequence[float],
-               interpolation: str = "linear", extrapolation: str = "hold") -> Expr:
+def read_table_file(file: str | Path, column: str | None) -> tuple[np.ndarray, np.ndarray]:
+    """(times, values) of ``column`` in the CSV ``file`` (first column ``time``)."""
+    import csv
+
+    path = Path(file)
+    if not column:
+        raise EquationError(f"time_table: file={str(path)!r} needs column=<name>")
+    if not path.is_file():
+        raise EquationError(f"time_table: the file {path} does not exist")
+    with path.open(newline="") as fh:
+        rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
+    if len(rows) < 2:
+        raise EquationError(f"time_table: {path} needs a header row and data rows")
+    head = [h.strip().strip('"') for h in rows[0]]
+    if head[0] != "time":
+        raise EquationError(f"time_table: {path}: the first column must be 'time', got "
+                            f"{head[0]!r}")
+    if column not in head[1:]:
+        raise EquationError(f"time_table: {path} has no column {column!r} (columns: "
+                            f"{', '.join(head[1:])})")
+    k = head.index(column)
+    t, v = [], []
+    for n, row in enumerate(rows[1:], start=2):
+        try:
+            t.append(float(row[0]))
+            v.append(float(row[k]))
+        except (ValueError, IndexError):
+            raise EquationError(f"time_table: {path} row {n}: time and {column} must be "
+                                "numbers") from None
+    return np.array(t), np.array(v)
+
+
+def time_table(times: Sequence[float] | None = None, values: Sequence[float] | None = None,
+               interpolation: str = "linear", extrapolation: str = "hold", *,
+               file: str | Path | None = None, column: str | None = None) -> Expr:
     """A function of ``time`` given by a table, like Modelica's CombiTimeTable.
 
     times: breakpoints [s], non-decreasing; a repeated time is a jump (the later row holds
@@ -198,7 +233,20 @@ def time_table(times: Sequence[float], values: Sequence[float],
     the next). extrapolation: "hold" (first/last value), "periodic" (the table repeats with
     period ``times[-1] - times[0]``) or "linear" (first/last segment continued).
     Breakpoints are time events, so jumps and kinks are hit exactly.
+
+    From a file: ``time_table(file="profile.csv", column="u")`` reads a CSV whose first
+    column is ``time`` (header row, then numbers). An exported FMU carries the file in its
+    resources and reads it when instantiated, so the table can be changed without
+    re-exporting (the number of rows may change too).
     """
+    source = None
+    if file is not None:
+        if times is not None or values is not None:
+            raise EquationError("time_table: give either times and values or file=")
+        times, values = read_table_file(file, column)
+        source = (str(Path(file).resolve()), str(column))
+    elif times is None or values is None:
+        raise EquationError("time_table: needs times and values, or file= and column=")
     t = np.asarray(times, dtype=float).ravel()
     v = np.asarray(values, dtype=float).ravel()
     if t.size == 0 or t.size != v.size:
@@ -218,7 +266,7 @@ def time_table(times: Sequence[float], values: Sequence[float],
     if extrapolation == "periodic" and not t[-1] > t[0]:
         raise EquationError("time_table: periodic extrapolation needs times[-1] > times[0]")
     HYBRID_NODES[0] += 1
-    table = TimeTable(t, v, interpolation, extrapolation)
+    table = TimeTable(t, v, interpolation, extrapolation, source)
     from .variables import time as _time
     return table.leaf + table.c1.leaf * _time
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -72,6 +73,11 @@ def export_fmu(spec: FmuSpec, out_dir: str | Path, fmi_version: int = 2,
             spec, table, deps, fmi_version, ident, token, interfaces, sources))
         if fmi_version == 3:
             (src / "buildDescription.xml").write_bytes(build_description_xml(ident, sources))
+        for tb in spec.hybrid.tables if spec.hybrid is not None else ():
+            if tb.source:                  # tables read from files travel in the resources
+                target = root / "resources" / tb.resource
+                target.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(tb.source[0], target)
         plat, ext = platform_dir(fmi_version)
         compile_shared_library(src, root / "binaries" / plat / f"{ident}{ext}", compiler)
         return zip_fmu(root, Path(out_dir) / f"{ident}.fmu")

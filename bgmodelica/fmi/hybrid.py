@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Any
 
 import casadi as ca
@@ -59,6 +60,8 @@ class TableData:
     values: tuple[float, ...]
     hold: bool
     extrapolation: str
+    source: tuple[str, str] | None = None   # (file path, column): read from the resources
+    resource: str = ""                      # the file's name in the FMU's resources folder
 
 
 @dataclass
@@ -243,7 +246,11 @@ def build_hybrid(dae: CasadiDAE, flat, by_name: dict, z_of, pfull_of) -> HybridS
         reinits.append(row)
     tables = [TableData(tb.c0, tb.c1, tuple(float(v) for v in np.asarray(tb.times).ravel()),
                         tuple(float(v) for v in np.asarray(tb.values).ravel()),
-                        tb.interpolation == "hold", tb.extrapolation) for tb in hyb.tables]
+                        tb.interpolation == "hold", tb.extrapolation,
+                        getattr(tb, "source", None),
+                        f"tables/{k}_{Path(tb.source[0]).name}"
+                        if getattr(tb, "source", None) else "")
+              for k, tb in enumerate(hyb.tables)]
     for tb in tables:
         if tb.extrapolation not in EXTRAPOLATIONS or not tb.times:
             raise FmuSpecError(f"time table with extrapolation {tb.extrapolation!r} and "
@@ -367,6 +374,9 @@ def data_source(h: HybridSpec, model_name: str) -> str:
               "BGM_NTABA"),
         _doubles("bgm_tab_times", [v for tb in h.tables for v in tb.times], "BGM_NTABPTSA"),
         _doubles("bgm_tab_values", [v for tb in h.tables for v in tb.values], "BGM_NTABPTSA"),
+        _strings("bgm_tab_file", [tb.resource for tb in h.tables], "BGM_NTABA"),
+        _strings("bgm_tab_column", [tb.source[1] if tb.source else "" for tb in h.tables],
+                 "BGM_NTABA"),
         _ints("bgm_dv_type", [DV_TYPES.index(v.type) for v in h.discretes], "BGM_NDVA"),
         _ints("bgm_dv_slot", [v.slot for v in h.discretes], "BGM_NDVA"),
     ]

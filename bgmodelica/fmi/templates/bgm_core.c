@@ -270,6 +270,9 @@ bgm_inst *bgm_new(int fmi_version, int kind, const char *name, int logging_on,
         bgm_free(c);
         return NULL;
     }
+#if BGM_HYBRID
+    bgm_tables_init(c);
+#endif
     bgm_defaults(c);
     return c;
 }
@@ -288,6 +291,9 @@ void bgm_free(bgm_inst *c) {
     free(c->ws);
     free(c->piv);
     free(c->name);
+#if BGM_HYBRID
+    bgm_tables_free(c);
+#endif
     c->magic = 0;
     free(c);
 }

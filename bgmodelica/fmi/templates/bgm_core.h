@@ -128,6 +128,10 @@ typedef struct bgm_inst {
 #if BGM_HYBRID
     int early_return_allowed; /* FMI 3.0 Co-Simulation */
     bgm_hyb_work hw;          /* scratch of the event functions */
+    /* time tables: the compiled-in data, or a file of the FMU's resources (not FMU state) */
+    const double *tab_t[BGM_NTABA], *tab_v[BGM_NTABA];
+    int tab_n[BGM_NTABA];
+    double *tab_buf[BGM_NTABA];
 #endif
 } bgm_inst;
 
@@ -212,6 +216,10 @@ int bgm_call_jacx(bgm_inst *c, double t, const double *x, double *jac);
 /* events (bgm_events.c); bgm_call_event: which = 0 evstep, 1 evind, 2 evsamp */
 int bgm_call_event(bgm_inst *c, int which, double t, const double *x, double **outs, int nouts);
 void bgm_hyb_defaults(bgm_inst *c);
+void bgm_tables_init(bgm_inst *c);
+void bgm_tables_free(bgm_inst *c);
+int bgm_tables_load(bgm_inst *c, const char *dir);
+void bgm_resource_dir(const char *uri, char *out, size_t size);
 bgm_status bgm_hyb_initialize(bgm_inst *c, const char *fn);
 bgm_status bgm_hyb_enter_event(bgm_inst *c, const char *fn);
 bgm_status bgm_hyb_update(bgm_inst *c, const char *fn, int *need_update, int *x_changed,

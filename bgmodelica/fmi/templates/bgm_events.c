@@ -27,6 +27,7 @@
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "bgm_core.h"
@@ -137,9 +138,10 @@ static void segment(const double *times, const double *values, int a, int b, dou
 
 /* (c0, c1, next breakpoint): table i equals c0 + c1*time from t (right limit) up to the next
    breakpoint after t; a time within a few ulps of a breakpoint is the breakpoint itself */
-static void table_coefficients(int i, double t, double *c0, double *c1, double *nxt) {
-    const int first = bgm_tab_first[i], n = bgm_tab_first[i + 1] - bgm_tab_first[i];
-    const double *times = bgm_tab_times + first, *values = bgm_tab_values + first;
+static void table_coefficients(const bgm_inst *c, int i, double t, double *c0, double *c1,
+                               double *nxt) {
+    const int n = c->tab_n[i];
+    const double *times = c->tab_t[i], *values = c->tab_v[i];
     const int extrap = bgm_tab_extrap[i], hold = bgm_tab_hold[i];
     double t0 = times[0], t1 = times[n - 1];
     double eps = 1e-12 * dmax(dmax(1.0, fabs(t)), fabs(t1 - t0));
@@ -184,7 +186,7 @@ static void ev_update_tables(bgm_inst *c, double t) {
     int i;
     double c0, c1, nxt;
     for (i = 0; i < BGM_NTAB; i++) {
-        table_coefficients(i, t, &c0, &c1, &nxt);
+        table_coefficients(c, i, t, &c0, &c1, &nxt);
         c->v.h.d[bgm_tab_c0[i]] = c0;
         c->v.h.d[bgm_tab_c1[i]] = c1;
     }
@@ -206,7 +208,7 @@ static double ev_next_time(bgm_inst *c, double t) {
         best = dmin(best, dmax(ts, t));
     }
     for (i = 0; i < BGM_NTAB; i++) {
-        table_coefficients(i, t, &c0, &c1, &ts);
+        table_coefficients(c, i, t, &c0, &c1, &ts);
         best = dmin(best, ts);
     }
     return dmin(best, h->time_next);
@@ -825,3 +827,175 @@ bgm_status bgm_hyb_set_typed(bgm_inst *c, const char *fn, const unsigned vr[], s
 #else
 typedef int bgm_events_unused; /* ISO C: no empty translation unit */
 #endif
+
+/* ------------------------------------------------------------- tables from resources */
+
+/* the compiled-in tables */
+void bgm_tables_init(bgm_inst *c) {
+    int i;
+    for (i = 0; i < BGM_NTAB; i++) {
+        c->tab_t[i] = bgm_tab_times + bgm_tab_first[i];
+        c->tab_v[i] = bgm_tab_values + bgm_tab_first[i];
+        c->tab_n[i] = bgm_tab_first[i + 1] - bgm_tab_first[i];
+        c->tab_buf[i] = NULL;
+    }
+}
+
+void bgm_tables_free(bgm_inst *c) {
+    int i;
+    for (i = 0; i < BGM_NTAB; i++) {
+        free(c->tab_buf[i]);
+        c->tab_buf[i] = NULL;
+    }
+}
+
+/* the next comma-separated field of *s (trimmed, quotes removed) into out */
+static int csv_field(const char **s, char *out, size_t size) {
+    const char *p = *s, *end;
+    size_t n;
+    if (*p == '\0' || *p == '\n' || *p == '\r') return 0;
+    end = p;
+    while (*end && *end != ',' && *end != '\n' && *end != '\r') end++;
+    while (p < end && (*p == ' ' || *p == '"')) p++;
+    n = (size_t)(end - p);
+    while (n > 0 && (p[n - 1] == ' ' || p[n - 1] == '"')) n--;
+    if (n >= size) n = size - 1;
+    memcpy(out, p, n);
+    out[n] = '\0';
+    *s = *end == ',' ? end + 1 : end;
+    return 1;
+}
+
+/* one table from "<resources>/<file>": a header row whose first column is time, then rows */
+static int load_table(bgm_inst *c, int i, const char *dir) {
+    char path[4096], field[256], line[8192];
+    FILE *f;
+    int col = -1, k, rows = 0, cap = 64;
+    double *buf;
+    const char *s;
+    snprintf(path, sizeof path, "%s%s%s", dir, (dir[0] && dir[strlen(dir) - 1] != '/') ? "/" : "",
+             bgm_tab_file[i]);
+    f = fopen(path, "r");
+    if (!f) {
+        bgm_log(c, BGM_ERROR, "logStatusError", "time table: cannot open the resource file %s",
+                path);
+        return 1;
+    }
+    if (!fgets(line, sizeof line, f)) {
+        fclose(f);
+        bgm_log(c, BGM_ERROR, "logStatusError", "time table: %s is empty", path);
+        return 1;
+    }
+    s = line;
+    for (k = 0; csv_field(&s, field, sizeof field); k++) {
+        if (k == 0 && strcmp(field, "time") != 0) break;
+        if (strcmp(field, bgm_tab_column[i]) == 0) col = k;
+    }
+    if (col <= 0) {
+        fclose(f);
+        bgm_log(c, BGM_ERROR, "logStatusError",
+                "time table: %s needs a first column 'time' and a column '%s'", path,
+                bgm_tab_column[i]);
+        return 1;
+    }
+    buf = (double *)malloc(2 * (size_t)cap * sizeof(double));
+    while (buf && fgets(line, sizeof line, f)) {
+        double t = 0.0, v = 0.0;
+        int got = 0;
+        char *end;
+        s = line;
+        for (k = 0; csv_field(&s, field, sizeof field) && k <= col; k++) {
+            if (k != 0 && k != col) continue;
+            if (k == 0) t = strtod(field, &end);
+            else v = strtod(field, &end);
+            if (end == field || *end != '\0' || t != t || v != v) {
+                got = -1;
+                break;
+            }
+            got++;
+        }
+        if (got == 0) continue;              /* a blank line */
+        if (got != 2 || (rows > 0 && t < buf[2 * (rows - 1)])) {
+            bgm_log(c, BGM_ERROR, "logStatusError", "time table: %s row %d: %s", path,
+                    rows + 2, got != 2 ? "not two numbers in time and the column"
+                                       : "time decreases");
+            free(buf);
+            fclose(f);
+            return 1;
+        }
+        if (rows == cap) {
+            double *more = (double *)realloc(buf, 4 * (size_t)cap * sizeof(double));
+            if (!more) break;
+            buf = more;
+            cap *= 2;
+        }
+        buf[2 * rows] = t;
+        buf[2 * rows + 1] = v;
+        rows++;
+    }
+    fclose(f);
+    if (!buf || rows == 0) {
+        free(buf);
+        bgm_log(c, BGM_ERROR, "logStatusError", "time table: %s has no data rows", path);
+        return 1;
+    }
+    /* split into times and values */
+    c->tab_buf[i] = (double *)malloc(2 * (size_t)rows * sizeof(double));
+    if (!c->tab_buf[i]) {
+        free(buf);
+        return 1;
+    }
+    for (k = 0; k < rows; k++) {
+        c->tab_buf[i][k] = buf[2 * k];
+        c->tab_buf[i][rows + k] = buf[2 * k + 1];
+    }
+    free(buf);
+    c->tab_t[i] = c->tab_buf[i];
+    c->tab_v[i] = c->tab_buf[i] + rows;
+    c->tab_n[i] = rows;
+    bgm_log(c, BGM_OK, "logEvents", "time table: %d rows of '%s' from %s", rows,
+            bgm_tab_column[i], path);
+    return 0;
+}
+
+/* Tables declared from files are read from the FMU's resources folder; a failure (logged)
+   returns nonzero. ``dir``: the folder (NULL or "": no tables from files can be read). */
+int bgm_tables_load(bgm_inst *c, const char *dir) {
+    int i;
+    for (i = 0; i < BGM_NTAB; i++) {
+        if (!bgm_tab_file[i][0]) continue;
+        if (!dir || !dir[0]) {
+            bgm_log(c, BGM_ERROR, "logStatusError",
+                    "time table: the resource location is unknown; cannot read %s",
+                    bgm_tab_file[i]);
+            return 1;
+        }
+        if (load_table(c, i, dir)) return 1;
+    }
+    return 0;
+}
+
+/* FMI 2.0 fmuResourceLocation (a URI: file:///C:/x, file:/x, file://host/x) as a path;
+   percent-escapes decoded. Anything else is taken as a path. */
+void bgm_resource_dir(const char *uri, char *out, size_t size) {
+    const char *p = uri ? uri : "";
+    size_t n = 0;
+    if (strncmp(p, "file://", 7) == 0) {
+        p += 7;
+        if (*p != '/') {                       /* file://host/path: skip the host */
+            while (*p && *p != '/') p++;
+        }
+    } else if (strncmp(p, "file:", 5) == 0) {
+        p += 5;
+    }
+    while (*p && n + 1 < size) {
+        if (p[0] == '%' && p[1] && p[2]) {
+            char hex[3] = {p[1], p[2], 0};
+            out[n++] = (char)strtol(hex, NULL, 16);
+            p += 3;
+        } else {
+            out[n++] = *p++;
+        }
+    }
+    out[n] = '\0';
+}

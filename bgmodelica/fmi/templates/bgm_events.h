@@ -94,6 +94,7 @@ extern const int bgm_sample_slot[BGM_NSAMPA];
 extern const int bgm_tab_c0[BGM_NTABA], bgm_tab_c1[BGM_NTABA], bgm_tab_first[BGM_NTABA + 1];
 extern const int bgm_tab_hold[BGM_NTABA], bgm_tab_extrap[BGM_NTABA];
 extern const double bgm_tab_times[BGM_NTABPTSA], bgm_tab_values[BGM_NTABPTSA];
+extern const char *const bgm_tab_file[BGM_NTABA], *const bgm_tab_column[BGM_NTABA];
 extern const int bgm_dv_type[BGM_NDVA], bgm_dv_slot[BGM_NDVA];
 
 /* table extrapolation codes */

@@ -39,7 +39,6 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     const char *name = instanceName ? instanceName : "(null)";
     int kind;
     bgm_inst *inst;
-    (void)fmuResourceLocation;
     (void)visible;
     if (!instanceName || !instanceName[0]) {
         if (logger)
@@ -66,6 +65,18 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     inst = bgm_new(2, kind, instanceName, loggingOn, fmi2_emit, (bgm_any_fn)logger, env);
     if (!inst && logger)
         logger(env, name, fmi2Fatal, "logStatusError", "fmi2Instantiate: out of memory");
+#if BGM_HYBRID
+    if (inst) {                                   /* tables from resource files */
+        char dir[4096];
+        bgm_resource_dir(fmuResourceLocation, dir, sizeof dir);
+        if (bgm_tables_load(inst, dir)) {
+            bgm_free(inst);
+            return NULL;
+        }
+    }
+#else
+    (void)fmuResourceLocation;
+#endif
     return (fmi2Component)inst;
 }
 

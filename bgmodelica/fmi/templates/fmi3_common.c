@@ -25,8 +25,9 @@ static void fmi3_emit(bgm_inst *inst, int status, const char *category, const ch
 }
 
 static bgm_inst *fmi3_new(const char *fn, int kind, fmi3String instanceName,
-                          fmi3String instantiationToken, fmi3Boolean loggingOn,
-                          fmi3InstanceEnvironment env, fmi3LogMessageCallback logMessage) {
+                          fmi3String instantiationToken, fmi3String resourcePath,
+                          fmi3Boolean loggingOn, fmi3InstanceEnvironment env,
+                          fmi3LogMessageCallback logMessage) {
     char msg[512];
     bgm_inst *inst;
     if (!instanceName || !instanceName[0]) {
@@ -54,6 +55,14 @@ static bgm_inst *fmi3_new(const char *fn, int kind, fmi3String instanceName,
     }
     inst = bgm_new(3, kind, instanceName, loggingOn, fmi3_emit, (bgm_any_fn)logMessage, env);
     if (!inst && logMessage) logMessage(env, fmi3Fatal, "logStatusError", "out of memory");
+#if BGM_HYBRID
+    if (inst && bgm_tables_load(inst, resourcePath)) {     /* tables from resource files */
+        bgm_free(inst);
+        return NULL;
+    }
+#else
+    (void)resourcePath;
+#endif
     return inst;
 }
 
@@ -71,11 +80,10 @@ fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName,
                                           fmi3Boolean loggingOn,
                                           fmi3InstanceEnvironment instanceEnvironment,
                                           fmi3LogMessageCallback logMessage) {
-    (void)resourcePath;
     (void)visible;
     return (fmi3Instance)fmi3_new("fmi3InstantiateModelExchange", BGM_KIND_ME, instanceName,
-                                  instantiationToken, loggingOn, instanceEnvironment,
-                                  logMessage);
+                                  instantiationToken, resourcePath, loggingOn,
+                                  instanceEnvironment, logMessage);
 }
 
 fmi3Instance fmi3InstantiateCoSimulation(
@@ -85,7 +93,6 @@ fmi3Instance fmi3InstantiateCoSimulation(
     size_t nRequiredIntermediateVariables, fmi3InstanceEnvironment instanceEnvironment,
     fmi3LogMessageCallback logMessage, fmi3IntermediateUpdateCallback intermediateUpdate) {
     bgm_inst *inst;
-    (void)resourcePath;
     (void)visible;
 #if !BGM_HYBRID
     (void)earlyReturnAllowed;
@@ -93,7 +100,8 @@ fmi3Instance fmi3InstantiateCoSimulation(
     (void)requiredIntermediateVariables;
     (void)intermediateUpdate;
     inst = fmi3_new("fmi3InstantiateCoSimulation", BGM_KIND_CS, instanceName,
-                    instantiationToken, loggingOn, instanceEnvironment, logMessage);
+                    instantiationToken, resourcePath, loggingOn, instanceEnvironment,
+                    logMessage);
     if (inst) {
         inst->event_mode_used = eventModeUsed ? 1 : 0;
 #if BGM_HYBRID
