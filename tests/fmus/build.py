@@ -1,5 +1,5 @@
-"""Build the C test FMUs of this folder (FMI 3.0, Model Exchange and Co-Simulation in one
-binary each) with the system C compiler against the FMI headers fmpy ships.
+"""Build the C test FMUs of this folder (Model Exchange and Co-Simulation in one binary each)
+with the system C compiler against the FMI headers fmpy ships.
 
     from build import build_fmu          # tests/fmus on sys.path (conftest)
     path = build_fmu("Feedthrough", out_dir)       # -> out_dir/Feedthrough.fmu
@@ -11,7 +11,11 @@ Models (C sources in ``src/``, runtime ``src/glue3.c``):
 * ``StateSpace`` - der(x) = A x + B u, y = C x + D u with array variables sized by
   structural parameters;
 * ``Resource`` - reads ``resources/y.txt`` at initialization, outputs its first byte;
-* ``Countdown`` - an Int32 counter stepped down by time events; asks to terminate at 0.
+* ``Countdown`` - an Int32 counter stepped down by time events; asks to terminate at 0;
+* ``Feedthrough2`` - FMI 2.0: Real, Integer, Boolean, String and Enumeration inputs fed
+  through, with the outputs' dependencies declared (runtime ``src/glue2.c``).
+
+The others are FMI 3.0 (runtime ``src/glue3.c``).
 
 The FMUs support getting and setting the FMU state (rollback).
 """
@@ -83,6 +87,59 @@ MODELS = {
 }
 
 
+_FEED2 = [("time", 0, "Real", "independent", "continuous", None),
+          ("Float64_continuous_input", 1, "Real", "input", "continuous", "0"),
+          ("Float64_continuous_output", 2, "Real", "output", "continuous", None),
+          ("Float64_discrete_input", 3, "Real", "input", "discrete", "0"),
+          ("Float64_discrete_output", 4, "Real", "output", "discrete", None),
+          ("Int32_input", 5, "Integer", "input", "discrete", "0"),
+          ("Int32_output", 6, "Integer", "output", "discrete", None),
+          ("Boolean_input", 7, "Boolean", "input", "discrete", "false"),
+          ("Boolean_output", 8, "Boolean", "output", "discrete", None),
+          ("String_input", 9, "String", "input", "discrete", "Set me!"),
+          ("String_output", 10, "String", "output", "discrete", None),
+          ("Enumeration_input", 11, "Enumeration", "input", "discrete", "1"),
+          ("Enumeration_output", 12, "Enumeration", "output", "discrete", None),
+          ("Float64_fixed_parameter", 13, "Real", "parameter", "fixed", "1"),
+          ("Float64_tunable_parameter", 14, "Real", "parameter", "tunable", "2"),
+          ("Float64_parameter_sum", 15, "Real", "output", "continuous", None)]
+
+#: FMI 2.0 models: name -> (C file, GUID, variables, output vr -> input vr it feeds from)
+MODELS2 = {"Feedthrough2": ("feedthrough2.c", "{bgm-test-feedthrough2}", _FEED2,
+                            {2: 1, 4: 3, 6: 5, 8: 7, 10: 9, 12: 11, 15: None})}
+
+
+def model_description2(name: str) -> str:
+    """The FMI 2.0 ``modelDescription.xml`` of the test FMU ``name``."""
+    _, guid, variables, feeds = MODELS2[name]
+    body = ""
+    for vname, vr, typ, causality, variability, start in variables:
+        attrs = f' start={quoteattr(start)}' if start is not None else ""
+        if typ == "Enumeration":
+            attrs = ' declaredType="Option"' + attrs
+        initial = ' initial="calculated"' if causality == "output" else ""
+        body += (f'    <ScalarVariable name={quoteattr(vname)} valueReference="{vr}" '
+                 f'causality="{causality}" variability="{variability}"{initial}>'
+                 f'<{typ}{attrs}/></ScalarVariable>\n')
+    outputs = "".join(
+        f'      <Unknown index="{vr + 1}" dependencies="{"" if src is None else src + 1}"/>\n'
+        for vr, src in feeds.items())
+    return (f'<?xml version="1.0" encoding="UTF-8"?>\n'
+            f'<fmiModelDescription fmiVersion="2.0" modelName="{name}" guid="{guid}" '
+            f'generationTool="bgmodelica test FMUs" numberOfEventIndicators="0">\n'
+            f'  <ModelExchange modelIdentifier="{name}" canGetAndSetFMUstate="true"/>\n'
+            f'  <CoSimulation modelIdentifier="{name}" canGetAndSetFMUstate="true" '
+            f'canHandleVariableCommunicationStepSize="true"/>\n'
+            f'  <TypeDefinitions>\n    <SimpleType name="Option">\n      <Enumeration>\n'
+            f'        <Item name="Option 1" value="1"/>\n        <Item name="Option 2" '
+            f'value="2"/>\n      </Enumeration>\n    </SimpleType>\n  </TypeDefinitions>\n'
+            f'  <DefaultExperiment startTime="0" stopTime="2" stepSize="0.1"/>\n'
+            f'  <ModelVariables>\n{body}  </ModelVariables>\n'
+            f'  <ModelStructure>\n    <Outputs>\n{outputs}    </Outputs>\n'
+            f'    <InitialUnknowns>\n{outputs}    </InitialUnknowns>\n'
+            f'  </ModelStructure>\n</fmiModelDescription>\n')
+
+
 def _variable_xml(v: tuple) -> str:
     name, vr, typ, causality, variability, start = v[:6]
     dims = v[6] if len(v) > 6 else ()
@@ -144,7 +201,8 @@ def _compiler() -> str:
 def build_fmu(name: str, out_dir: str | Path, resource_text: str | None = "A") -> Path:
     """Compile the test FMU ``name`` and zip it into ``out_dir/name.fmu`` (Linux x86-64).
     ``resource_text``: the content of ``resources/y.txt`` (Resource; None: no file)."""
-    source = MODELS[name][0]
+    fmi2 = name in MODELS2
+    source = (MODELS2 if fmi2 else MODELS)[name][0]
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     headers = Path(str(resources.files("fmpy"))) / "c-code"
@@ -157,10 +215,11 @@ def build_fmu(name: str, out_dir: str | Path, resource_text: str | None = "A") -
             raise RuntimeError(f"compiling {source} failed:\n{run.stderr}")
         fmu = out_dir / f"{name}.fmu"
         with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as zf:
-            zf.writestr("modelDescription.xml", model_description(name))
-            zf.write(lib, f"binaries/x86_64-linux/{name}.so")
+            zf.writestr("modelDescription.xml",
+                        model_description2(name) if fmi2 else model_description(name))
+            zf.write(lib, f"binaries/{'linux64' if fmi2 else 'x86_64-linux'}/{name}.so")
             if name == "Resource" and resource_text is not None:
                 zf.writestr("resources/y.txt", resource_text)
-            for src in ("glue3.h", "glue3.c", source):
+            for src in (("glue2.c",) if fmi2 else ("glue3.h", "glue3.c")) + (source,):
                 zf.write(SRC / src, f"sources/{src}")
     return fmu

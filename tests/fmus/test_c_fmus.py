@@ -32,7 +32,8 @@ def _fmutool() -> str | None:
     return str(exe) if exe.exists() else shutil.which("fmutool")
 
 
-@pytest.mark.parametrize("name", ["Feedthrough", "StateSpace", "Resource", "Countdown"])
+@pytest.mark.parametrize("name", ["Feedthrough", "StateSpace", "Resource", "Countdown",
+                                  "Feedthrough2"])
 def test_valid_for_fmpy_and_fmutool(c_fmus, name):
     assert validate_fmu(str(c_fmus[name])) == []
     tool = _fmutool()
@@ -148,3 +149,28 @@ def test_terminate_request_ends_the_run(c_fmus, interface):
     assert np.array_equal(res["counter"][steps], 3 - np.floor(res.time[steps] + 1e-9))
     assert res["counter"][-1] == 0
     assert np.allclose(res["x"], res.time, atol=1e-9)
+
+
+@pytest.mark.parametrize("interface", ["me", "cs"])
+def test_fmi2_types_through_a_chain(c_fmus, interface):
+    """FMI 2.0: a.Int32_input steps from 3 to 5 at t = 1 s (a discrete input: set in event
+    mode under Model Exchange) and reaches b through Integer, Boolean, Enumeration and Real
+    connections; String set by name."""
+    path = c_fmus["Feedthrough2"]
+    kinds = ["Float64_continuous", "Float64_discrete", "Int32", "Boolean", "Enumeration"]
+    system = system_from_fmus("chain2", {"a": path, "b": path},
+                              [("a", f"{k}_output", "b", f"{k}_input") for k in kinds])
+    master = Master(system, interface=interface, allow_unconnected=True)
+    assert master.infos["a"].variables["Int32_input"].fmi_type == "Integer"
+    res = master.simulate(2.0, 0.1, parameters={"a": {"Boolean_input": True,
+                                                       "Enumeration_input": 2,
+                                                       "String_input": "hello"}},
+                          inputs={"a.Int32_input": ([0, 1, 1, 2], [3, 3, 5, 5]),
+                                  "a.Float64_continuous_input": ([0, 2], [0, 4])})
+    t = res.time
+    assert np.array_equal(res["b.Int32_output"], np.where(t < 1 - 1e-9, 3.0, 5.0))
+    assert np.all(res["b.Boolean_output"] == 1.0) and np.all(res["b.Enumeration_output"] == 2)
+    assert np.allclose(res["b.Float64_continuous_output"], 2 * t)
+    assert res["a.Float64_parameter_sum"][-1] == 3.0
+    # the declared dependencies make the outputs direct feedthrough: evaluated in order
+    assert master.plan.feedthrough["a"]["Int32_output"] == ["Int32_input"]
