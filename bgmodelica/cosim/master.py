@@ -289,21 +289,35 @@ class Master:
             y = {n: units[n].get_outputs() for n in names}
             last_set = {n: start_u[n].copy() for n in names}
 
-            def coupled(n: str, ys: dict[str, np.ndarray]) -> np.ndarray:
-                u = start_u[n].copy()
+            # per element: (source element, its output positions, our input positions)
+            gather: dict[str, list[tuple[str, np.ndarray, np.ndarray]]] = {}
+            for n in names:
+                by_src: dict[str, tuple[list[int], list[int]]] = {}
                 for j, s in enumerate(src_index[n]):
                     if s is not None:
-                        u[j] = ys[s[0]][s[1]]
+                        pair = by_src.setdefault(s[0], ([], []))
+                        pair[0].append(s[1])
+                        pair[1].append(j)
+                gather[n] = [(src, np.array(a), np.array(b)) for src, (a, b) in by_src.items()]
+            # elements whose outputs feed through, in evaluation order (repeats kept apart)
+            feed_order: list[str] = []
+            for el, _, is_out in plan.order:
+                if is_out and has_feed[el] and (not feed_order or feed_order[-1] != el):
+                    feed_order.append(el)
+
+            def coupled(n: str, ys: dict[str, np.ndarray]) -> np.ndarray:
+                u = start_u[n].copy()
+                for src, from_pos, to_pos in gather[n]:
+                    u[to_pos] = ys[src][from_pos]
                 for j, f in signals.get(n, ()):
                     u[j] = f(t_now[0])
                 return u
 
             def propagate_outputs() -> None:
-                for el, _, is_out in plan.order:
-                    if not is_out or not has_feed[el]:
-                        continue
+                for el in feed_order:
                     u = coupled(el, y)
-                    if not np.array_equal(u, last_set[el]):
+                    last = last_set[el]
+                    if last is None or u.tolist() != last.tolist():
                         units[el].set_inputs(u)
                         last_set[el] = u
                         y[el] = units[el].get_outputs()

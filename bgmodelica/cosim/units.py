@@ -95,6 +95,10 @@ class _Unit:
         self._y_vr = (ctypes.c_uint32 * len(output_names))(
             *[info.variables[n].vr for n in output_names])
         self._y_buf = np.zeros(len(output_names))
+        self._u_buf = np.zeros(len(input_names))
+        self._y_ptr = self._y_buf.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+        self._u_ptr = self._u_buf.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+        self._raw: dict[str, Any] = {}        # the FMU's C functions (hot path, no wrapper)
         self._readers: dict[tuple[str, ...], PortAccess] = {}
         self.time = 0.0
         # (status, category, message) logged by the FMU; the last errors go into exceptions
@@ -133,6 +137,15 @@ class _Unit:
 
     def set_inputs(self, values: np.ndarray) -> None:
         """Set all inputs (in ``input_names`` order), each with its own FMI type."""
+        raw = self._raw.get("set")
+        if raw is not None:                   # scalar reals: one C call, no wrapper
+            n = len(self._u_buf)
+            self._u_buf[:] = values
+            status = raw(self.fmu.component, self._u_vr, n, self._u_ptr) if \
+                self.info.fmi_version == 2 else raw(self.fmu.component, self._u_vr, n,
+                                                    self._u_ptr, n)
+            if status <= 1:
+                return
         self._call(self._set_inputs, values)
 
     def _get_outputs(self) -> np.ndarray:
@@ -142,7 +155,28 @@ class _Unit:
 
     def get_outputs(self) -> np.ndarray:
         """All outputs (in ``output_names`` order) as float64, a fresh array."""
+        raw = self._raw.get("get")
+        if raw is not None:
+            n = len(self._y_buf)
+            status = raw(self.fmu.component, self._y_vr, n, self._y_ptr) if \
+                self.info.fmi_version == 2 else raw(self.fmu.component, self._y_vr, n,
+                                                    self._y_ptr, n)
+            if status <= 1:
+                return self._y_buf.copy()
         return self._call(self._get_outputs).copy()
+
+    def _bind_raw(self) -> None:
+        """Keep the FMU's own C functions for the per-step calls on scalar reals."""
+        functions = getattr(self.fmu, "_functions", {})
+        if self.info.fmi_version == 2:
+            names = {"set": "fmi2SetReal", "get": "fmi2GetReal", "step": "fmi2DoStep"}
+        else:
+            names = {"set": "fmi3SetFloat64", "get": "fmi3GetFloat64"}
+        self._raw = {k: functions[v] for k, v in names.items() if v in functions}
+        if not (self._in.all_real and len(self._u_buf)):
+            self._raw.pop("set", None)
+        if not (self._out.all_real and len(self._y_buf)):
+            self._raw.pop("get", None)
 
     def get(self, names: list[str]) -> np.ndarray:
         """Values of any numeric or Boolean variables by name (locals, states, parameters,
@@ -227,6 +261,7 @@ class _Unit:
             self._fmi2_id = unit_id
             self._callbacks = _fmi2_callbacks(unit_id)   # the FMU keeps a pointer to it
             self._call(self.fmu.instantiate, callbacks=self._callbacks)
+            self._bind_raw()
         else:
             ref = weakref.ref(self)
 
@@ -237,6 +272,7 @@ class _Unit:
 
             self._callbacks = log3                # fmpy keeps it as fmu.logMessage too
             self._call(self.fmu.instantiate, logMessage=log3)
+            self._bind_raw()
 
     def terminate(self) -> None:
         if self.fmu is None:
@@ -303,20 +339,30 @@ class CoSimUnit(_Unit):
     def _step2(self, t: float, h: float) -> None:
         from fmpy.fmi1 import FMICallException
 
-        try:
-            self.fmu.doStep(t, h)
-        except FMICallException as err:
-            if err.status == 2 and self._fmi2_terminated():      # fmi2Discard
-                self.terminated = True
-                self.stop_reason = "the FMU asked to terminate the simulation (doStep " \
-                                   "returned Discard, fmi2Terminated)"
-                try:
-                    self.time = float(self.fmu.getRealStatus(2))  # fmi2LastSuccessfulTime
-                except Exception:  # noqa: BLE001 - optional status
-                    self.time = t
+        raw = self._raw.get("step")
+        if raw is not None:                          # the C function, no wrapper
+            status = raw(self.fmu.component, t, h, 1)
+            if status <= 1:                          # fmi2OK, fmi2Warning
+                self.time = t + h
                 return
-            self._call(self._raise, err)
-        self.time = t + h
+            err = FMICallException(function="fmi2DoStep", status=status)
+        else:
+            try:
+                self.fmu.doStep(t, h)
+                self.time = t + h
+                return
+            except FMICallException as exc:
+                err = exc
+        if err.status == 2 and self._fmi2_terminated():          # fmi2Discard
+            self.terminated = True
+            self.stop_reason = "the FMU asked to terminate the simulation (doStep " \
+                               "returned Discard, fmi2Terminated)"
+            try:
+                self.time = float(self.fmu.getRealStatus(2))      # fmi2LastSuccessfulTime
+            except Exception:  # noqa: BLE001 - optional status
+                self.time = t
+            return
+        self._call(self._raise, err)
 
     @staticmethod
     def _raise(err: Exception) -> None:
