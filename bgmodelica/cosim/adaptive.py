@@ -171,7 +171,7 @@ def cosimulate_adaptive(system: SystemStructure | str | Path, stop_time: float |
                              plan.outputs[n], rtol=me_rtol, atol=me_atol)
             units[n] = unit
             pset = {k: v for k, v in params[n].items()
-                    if master.infos[n].variables[k].causality == "parameter"}
+                    if master.infos[n].variables[k].set_by_name}
             unit.setup(t0, t_end, pset, start_u[n], None)
         y = {n: units[n].get_outputs() for n in names}
         scale = {n: np.maximum(np.abs(y[n]), scale_floor) for n in names}

@@ -68,6 +68,13 @@ class FmuVariable:
             return True
         return self.causality == "parameter" and self.variability in ("fixed", "tunable")
 
+    @property
+    def set_by_name(self) -> bool:
+        """Set at start-up by name rather than as a signal: a parameter, or the start value of
+        a String or Binary input."""
+        return self.causality == "parameter" or (self.causality == "input"
+                                                 and self.type in ("String", "Binary"))
+
     def range_text(self) -> str:
         lo = "-inf" if self.min is None else f"{self.min:g}"
         hi = "inf" if self.max is None else f"{self.max:g}"

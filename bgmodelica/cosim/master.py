@@ -284,7 +284,7 @@ class Master:
                                  plan.outputs[n], rtol=self.me_rtol, atol=self.me_atol)
                 units[n] = unit
                 pset = {k: v for k, v in params[n].items()
-                        if self.infos[n].variables[k].causality == "parameter"}
+                        if self.infos[n].variables[k].set_by_name}
                 unit.setup(t0, t_end, pset, start_u[n], tolerance)
             y = {n: units[n].get_outputs() for n in names}
             last_set = {n: start_u[n].copy() for n in names}

@@ -90,7 +90,7 @@ class SspComponent:
     name: str
     source: str                                  # as written in the SSD
     connectors: list[SspConnector] = field(default_factory=list)
-    parameters: dict[str, float] = field(default_factory=dict)
+    parameters: dict[str, Any] = field(default_factory=dict)   # numbers; str for String
     type: str = FMU_TYPE
     implementation: str = "any"                  # any, CoSimulation, ModelExchange
     fmu_path: Path | None = None                 # the FMU file (resolved)
@@ -172,12 +172,14 @@ def system_from_fmus(name: str, fmus: Mapping[str, str | Path],
         bound = dict(parameters.get(el, {}))
         for pname in bound:
             var = info.variables.get(pname)
-            if var is None or var.causality != "parameter":
+            if var is None or not var.settable:
                 raise UnknownConnectorError(
-                    f"element {el!r} ({Path(path).name}) has no parameter {pname!r}")
-            conns.append(SspConnector(pname, "parameter", var.type, var.unit))
+                    f"element {el!r} ({Path(path).name}) has no parameter or input {pname!r}")
+            if var.causality == "parameter":
+                conns.append(SspConnector(pname, "parameter", var.type, var.unit))
         elements.append(SspComponent(el, f"resources/{Path(path).name}", conns,
-                                     {k: float(v) for k, v in bound.items()},
+                                     {k: v if isinstance(v, str) else float(v)
+                                      for k, v in bound.items()},
                                      fmu_path=Path(path),
                                      description=info.description.description or ""))
     if stop_time is None:
@@ -248,6 +250,16 @@ def ssd_xml(system: SystemStructure) -> bytes:
             for pname, value in comp.parameters.items():
                 p = ET.SubElement(params, _q("ssv", "Parameter"), name=pname)
                 conn = comp.connector(pname)
+                kind = conn.type if conn is not None else "Real"
+                if isinstance(value, str) or kind == "String":
+                    ET.SubElement(p, _q("ssv", "String"), value=str(value))
+                    continue
+                if kind == "Boolean":
+                    ET.SubElement(p, _q("ssv", "Boolean"), value="true" if value else "false")
+                    continue
+                if kind in ("Integer", "Enumeration"):
+                    ET.SubElement(p, _q("ssv", "Integer"), value=str(int(value)))
+                    continue
                 ra = {"value": _num(value)}
                 unit = comp.parameter_units.get(pname) or (conn.unit if conn is not None
                                                           else "")
@@ -360,10 +372,10 @@ def _float(text: str | None, what: str) -> float:
 
 
 def _parameter_set(ps: ET.Element, where: str, prefix: str = "",
-                   units: dict[str, str] | None = None) -> dict[str, float]:
+                   units: dict[str, str] | None = None) -> dict[str, Any]:
     if _local(ps.tag) != (NS["ssv"], "ParameterSet"):
         raise SspFormatError(f"{where}: expected <ssv:ParameterSet>, found <{ps.tag}>")
-    out: dict[str, float] = {}
+    out: dict[str, Any] = {}
     params = _child(ps, "ssv", "Parameters")
     for p in _children(params, "ssv", "Parameter") if params is not None else []:
         name = p.get("name")
@@ -375,12 +387,14 @@ def _parameter_set(ps: ET.Element, where: str, prefix: str = "",
             raise DuplicateElementError(f"{where}: parameter {name!r} is given twice in one "
                                         "parameter set")
         value = None
-        for typ in ("Real", "Integer", "Boolean"):
+        for typ in ("Real", "Integer", "Boolean", "String"):
             v = _child(p, "ssv", typ)
             if v is not None:
                 text = v.get("value")
                 what = f"{where}: parameter {name}"
-                if typ == "Boolean":
+                if typ == "String":
+                    value = text or ""
+                elif typ == "Boolean":
                     if text not in ("true", "false", "1", "0"):
                         raise SspFormatError(f"{what}: {text!r} is not a Boolean (true/false)")
                     value = 1.0 if text in ("true", "1") else 0.0
@@ -392,8 +406,8 @@ def _parameter_set(ps: ET.Element, where: str, prefix: str = "",
                     units[name] = v.get("unit")
                 break
         if value is None:
-            raise SspFormatError(f"{where}: parameter {name!r} has no Real/Integer/Boolean "
-                                 "value (only numeric parameters are supported)")
+            raise SspFormatError(f"{where}: parameter {name!r} has no Real/Integer/Boolean/"
+                                 "String value")
         out[name] = value
     return out
 

@@ -174,3 +174,23 @@ def test_fmi2_types_through_a_chain(c_fmus, interface):
     assert res["a.Float64_parameter_sum"][-1] == 3.0
     # the declared dependencies make the outputs direct feedthrough: evaluated in order
     assert master.plan.feedthrough["a"]["Int32_output"] == ["Int32_input"]
+
+
+def test_typed_values_in_an_ssp(c_fmus, tmp_path):
+    """SSP round trip: Integer, Boolean and String bindings keep their types; typed
+    connections run from the file."""
+    from bgmodelica.cosim.ssp import read_ssp, write_ssp
+
+    path = c_fmus["Feedthrough"]
+    system = system_from_fmus(
+        "chain", {"a": path, "b": path},
+        [("a", f"{k}_output", "b", f"{k}_input") for k in ("Int8", "Boolean", "UInt64")],
+        parameters={"a": {"Int8_input": -3, "Boolean_input": 1, "String_input": "hey",
+                          "UInt64_input": 2**40}})
+    back = read_ssp(write_ssp(system, tmp_path / "chain.ssp"))
+    bound = back.element("a").parameters
+    assert bound == {"Int8_input": -3.0, "Boolean_input": 1.0, "String_input": "hey",
+                     "UInt64_input": float(2**40)}
+    res = Master(back, allow_unconnected=True).simulate(0.2, 0.1)
+    assert res["b.Int8_output"][-1] == -3 and res["b.Boolean_output"][-1] == 1
+    assert res["b.UInt64_output"][-1] == 2**40
