@@ -77,7 +77,6 @@ def _check_simulate_args(args: argparse.Namespace) -> None:
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
-    from .cli_tools import choose_solver
     from .compiler import compile
     from .errors import SimulationError
     from .loader import load_model
@@ -100,7 +99,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     try:
         result = simulate(compiled, stop_time=args.stop_time, interval=args.interval,
                           params=params, rtol=args.rtol, atol=args.atol,
-                          solver=choose_solver(args.solver, compiled), max_step=args.max_step,
+                          solver=args.solver, max_step=args.max_step,
                           progress=_progress if show else None, inputs=args.input,
                           init=args.init)
     except SimulationError as err:          # keep what was computed, and say so

@@ -55,14 +55,6 @@ def register(sub: Any, model_args: Callable[[argparse.ArgumentParser], None]) ->
     lst.set_defaults(func=cmd_list)
 
 
-def choose_solver(name: str, compiled: Any) -> str:
-    """``--solver``: ``idas``, ``cvodes`` or ``auto`` (CVODES when the compiled model is an
-    explicit ODE -- no algebraic unknowns left -- else IDAS)."""
-    if name != "auto":
-        return name
-    return "cvodes" if compiled.dae.z.numel() == 0 else "idas"
-
-
 def autocomplete(parser: argparse.ArgumentParser) -> None:
     """Shell completion through ``argcomplete`` when it is installed (``pip install
     argcomplete; eval "$(register-python-argcomplete bgmodelica)"``); nothing otherwise."""

@@ -60,8 +60,11 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
     equation; NaN/Inf in the result :class:`SimulationError` naming the variable and time,
     with ``.result`` holding the rows before. params: overrides by dotted name
     of parameters, model inputs (held constant) or start values of variables. rtol/atol:
-    integrator tolerances; max_step: largest internal step [s]. solver: "idas" (default) or
-    "cvodes" (ODE models only). outputs: names to record (default: every variable).
+    integrator tolerances; max_step: largest internal step [s]. solver: "idas" (default),
+    "cvodes" (ODE models only) or "auto" (CVODES when the reduced model is an explicit ODE,
+    no algebraic unknowns left; IDAS otherwise); ``result.meta["solver"]`` says which ran
+    and ``meta["solver_choice"]`` whether it was chosen automatically. outputs: names to
+    record (default: every variable).
     dynamic: allow dynamic state selection when index reduction left a choice whose
     conditioning depends on the state (see :mod:`bgmodelica.dynamic_selection`).
     progress: called with the fraction done after each chunk of the run.
@@ -89,6 +92,13 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
     rtol, atol, max_step = opt["rtol"], opt["atol"], opt["max_step"]
     compiled = model if isinstance(model, CompiledModel) else compile(model, units=units)
     dae = compiled.dae
+    choice = "auto" if solver == "auto" else "given"
+    if solver == "auto":
+        solver = "cvodes" if dae.z.numel() == 0 else "idas"
+    elif solver == "cvodes" and dae.z.numel():
+        raise ParameterError(f"solver 'cvodes' cannot handle the {dae.z.numel()} algebraic "
+                             f"unknown(s) left in {compiled.name} (e.g. {dae.algebraic_names[0]}); "
+                             "use solver='idas' or 'auto'")
     t_start = _time.perf_counter()
     params = with_units(params or {}, compiled)
     p_over, start_over = _split_overrides(dae, params)
@@ -148,7 +158,8 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
     units.update({q.name: q.decl.unit for q in (*flat.parameters, *flat.inputs)})
     params_out = dae.parameter_values(p)
     meta = {"compile_seconds": compiled.compile_time, "run_seconds": run,
-            "timings": dict(compiled.timings), "solver": solver, "stats": stats,
+            "timings": dict(compiled.timings), "solver": solver, "solver_choice": choice,
+            "stats": stats,
             "states": list(dae.state_names), "init_notes": init.notes}
     kept = set(names)
     aliases = {a: rep for a, rep in flat.aliases.items() if rep[0] in kept}

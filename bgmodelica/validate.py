@@ -111,8 +111,8 @@ def check_run_options(*, start_time: Any = 0.0, stop_time: Any = 1.0, interval: 
     if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)) \
             or max_steps < 1:
         raise OptionError(f"max_steps must be a positive integer, got {max_steps!r}")
-    if solver not in ("idas", "cvodes"):
-        raise OptionError(f"solver must be 'idas' or 'cvodes', got {solver!r}")
+    if solver not in ("auto", "idas", "cvodes"):
+        raise OptionError(f"solver must be 'auto', 'idas' or 'cvodes', got {solver!r}")
     return {"start_time": t0, "stop_time": t1, "interval": h, "rtol": r, "atol": a,
             "max_step": ms, "max_steps": int(max_steps)}
 

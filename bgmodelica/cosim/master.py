@@ -62,6 +62,7 @@ from .errors import (
     UnknownConnectorError,
 )
 from .fmu import FmuInfo, read_fmu_info
+from .signals import input_signals
 from .ssp import SystemStructure, read_ssp
 from .units import make_unit
 
@@ -269,7 +270,7 @@ class Master:
             start_u[n] = np.array(su, dtype=float)
         has_feed = {n: any(plan.feedthrough[n].get(y) for y in plan.outputs[n])
                     for n in names}
-        signals = _input_signals(inputs or {}, plan, src_index)
+        signals = input_signals(inputs or {}, plan, src_index)
         for n, given in signals.items():
             for j, f in given:
                 start_u[n][j] = f(t0)
@@ -473,44 +474,3 @@ def cosimulate(system: SystemStructure | str | Path, stop_time: float | None = N
     """One-call form: ``Master(system, interface=...).simulate(stop_time, step, **options)``."""
     return Master(system, interface=interface).simulate(stop_time, step, **options)
 
-
-def _signal(times: np.ndarray, values: np.ndarray) -> Any:
-    """f(t): linear between breakpoints, a repeated time a jump (the later value from that
-    instant), the first/last value held outside. A macro step [t, t+h] ramps from f(t) to
-    the left limit f(t+h-), so a jump on the communication grid is taken exactly."""
-    last = len(times) - 1
-
-    def f(t: float, left: bool = False) -> float:
-        """The value at ``t``; ``left``: the limit from the left (before a jump at t)."""
-        k = int(np.searchsorted(times, t, side="left" if left else "right")) - 1
-        if k < 0:
-            return float(values[0])
-        if k >= last:
-            return float(values[last])
-        t0, t1 = times[k], times[k + 1]
-        return float(values[k] + (values[k + 1] - values[k]) * (t - t0) / (t1 - t0))
-
-    return f
-
-
-def _input_signals(inputs: Mapping[str, tuple[Any, Any]], plan: Plan,
-                   src_index: Mapping[str, list]) -> dict[str, list[tuple[int, Any]]]:
-    """element -> [(input position, f(t))] for the unconnected inputs given signals."""
-    out: dict[str, list[tuple[int, Any]]] = {}
-    for full, (times, values) in inputs.items():
-        el, _, name = full.partition(".")
-        if el not in plan.inputs or name not in plan.inputs[el]:
-            known = [f"{e}.{u}" for e in plan.inputs for u in plan.inputs[e]]
-            raise UnknownConnectorError(f"input signal {full!r}: no such input (inputs: "
-                                        f"{', '.join(known) or 'none'})")
-        j = plan.inputs[el].index(name)
-        if src_index[el][j] is not None:
-            raise SetupError(f"input signal {full!r}: the input is connected to an output")
-        t_arr = np.asarray(times, dtype=float).ravel()
-        v_arr = np.asarray(values, dtype=float).ravel()
-        if t_arr.size == 0 or t_arr.size != v_arr.size or np.any(np.diff(t_arr) < 0) \
-                or not (np.all(np.isfinite(t_arr)) and np.all(np.isfinite(v_arr))):
-            raise InvalidExperimentError(f"input signal {full!r}: needs as many finite times "
-                                         "(non-decreasing) as values")
-        out.setdefault(el, []).append((j, _signal(t_arr, v_arr)))
-    return out

@@ -45,7 +45,8 @@ def simulate_hybrid(compiled, dae: CasadiDAE, p: np.ndarray, grid: np.ndarray, *
     meta = {"compile_seconds": compiled.compile_time,
             "run_seconds": _time.perf_counter() - t_start,
             "timings": dict(compiled.timings), "solver": "cvodes" if not dae.z.numel()
-            else "idas", "stats": dict(sim.stats), "states": list(dae.state_names),
+            else "idas", "solver_choice": "auto",      # the event loop picks by structure
+            "stats": dict(sim.stats), "states": list(dae.state_names),
             "init_notes": [], **sim.meta}
     if selection is not None and selection.mode == "switch":
         meta["state_switches"] = list(selection.selector.switches)
