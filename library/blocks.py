@@ -507,7 +507,9 @@ class TimeTable(Component):
     Constructor arguments (fixed at construction):
 
     - ``table``: an N x M array (column 1 is time [s], non-decreasing) or the path of a CSV
-      file with a header row (first column time).
+      file with a header row (first column time). A CSV whose first column is named ``time``
+      (and ``timeScale`` 1) is read through ``time_table(file=...)``: an exported FMU carries
+      the file in its resources and reads it when instantiated.
     - ``column``: the output column, 1-based as in Modelica (column 1 is time, so the default
       2 is the first value column) or a header name of the CSV file.
     - ``smoothness``: "linear" (linear interpolation) or "hold" (constant from each breakpoint
@@ -547,11 +549,19 @@ class TimeTable(Component):
         object.__setattr__(self, "_values", data[:, index - 1].copy())
         object.__setattr__(self, "_smoothness", smoothness)
         object.__setattr__(self, "_extrapolation", extrapolation)
+        # a CSV with a 'time' column in seconds stays a file: exported FMUs carry it
+        from_file = names is not None and names[0] == "time" and timeScale == 1.0
+        object.__setattr__(self, "_file", (str(table), names[index - 1]) if from_file
+                           else None)
         super().__init__(**modifiers)
 
     def equations(self):
-        yield self.y == self.offset + time_table(self._times, self._values, self._smoothness,
-                                                 self._extrapolation)
+        if self._file is not None:
+            table = time_table(interpolation=self._smoothness, extrapolation=self._extrapolation,
+                               file=self._file[0], column=self._file[1])
+        else:
+            table = time_table(self._times, self._values, self._smoothness, self._extrapolation)
+        yield self.y == self.offset + table
 
 
 def _read_table(table) -> tuple[np.ndarray, list[str] | None]:

@@ -125,3 +125,26 @@ def test_native_errors_name_the_file_and_column(tmp_path):
     assert res.final("x") != 0.0
     assert np.interp(1.0 - 1e-9, res.time, res["x"]) == pytest.approx(2 * np.exp(-1.0),
                                                                       abs=1e-6)
+
+
+def test_library_time_table_block_carries_its_file(tmp_path):
+    """library.blocks.TimeTable on a CSV whose first column is 'time' exports the file."""
+    from bgmodelica import connect
+    from library.blocks import FirstOrder, TimeTable
+
+    csv = tmp_path / "profile.csv"
+    csv.write_text(PROFILE)
+
+    class Driven(Component):
+        tab = TimeTable(str(csv), column="u")
+        lag = FirstOrder(T=1.0)
+
+        def equations(self):
+            yield connect(self.tab.y, self.lag.u)
+
+    path = export_model(Driven(), tmp_path / "out", fmi_version=3, fmu_type="me")
+    assert "resources/tables/0_profile.csv" in zipfile.ZipFile(path).namelist()
+    new = _with_resource(path, tmp_path / "Driven.fmu", "time,u\n0,1\n5,1\n")
+    res = simulate_fmu(str(new), stop_time=2.0, output_interval=0.1,
+                       relative_tolerance=1e-10, output=["lag.y"])
+    assert np.max(np.abs(res["lag.y"] - _exact_u_const(res["time"], 1.0))) < 1e-6
