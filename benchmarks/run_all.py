@@ -1,0 +1,240 @@
+"""Run the benchmarks and write one JSON with the figures and the ratios against baselines
+measured in the same run; optionally rewrite the README's performance table from it.
+
+    python benchmarks/run_all.py [--full] [--json perf.json] [--readme]
+
+Quick mode (default, a few minutes): RC ladder n = 100, 1000; compile scaling of the ladder
+at about 1.4e3 and 1.4e4 equations; the robot; the co-simulation master against
+``fmucontainer``. ``--full`` adds the ladder at n = 10,000 and 100,000 and compile scaling at
+1.4e5 equations (the issue's acceptance sizes; much longer).
+
+Baselines: the RC ladder written by hand as a CasADi SX ODE and integrated with CVODES (the
+"floor"), and scipy's BDF with a sparse Jacobian (quick sizes); the robot's hand-written
+CasADi/CVODES ODE and scipy BDF (``robot_speed.py``); ``fmucontainer`` for the master.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import platform
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent))
+
+MARK_START, MARK_END = "<!-- perf-table:start -->", "<!-- perf-table:end -->"
+STOP, DT, RTOL, ATOL = 10.0, 0.01, 1e-6, 1e-6
+
+
+def ladder_by_hand(n: int) -> dict[str, float]:
+    """The RC ladder as one CasADi SX vector ODE, CVODES, same grid and tolerances."""
+    t0 = time.perf_counter()
+    v = ca.SX.sym("v", n)
+    t = ca.SX.sym("t")
+    i = np.arange(1, n + 1, dtype=float)
+    src = ca.sin(2 * math.pi * 10.0 * t)
+    prev = ca.vertcat(src, v[:-1])
+    current = i * (prev - v)                                 # through R_i = 1/i
+    nxt = ca.vertcat(current[1:], 0.0)
+    ode = (i ** 2) * (current - nxt)                         # C_i = 1/i^2
+    grid = np.linspace(0.0, STOP, int(round(STOP / DT)) + 1)
+    F = ca.integrator("ladder", "cvodes", {"x": v, "t": t, "ode": ode}, 0.0, list(grid[1:]),
+                      {"abstol": ATOL, "reltol": RTOL})
+    t1 = time.perf_counter()
+    xf = np.asarray(F(x0=i)["xf"])
+    t2 = time.perf_counter()
+    return {"build": t1 - t0, "solve": t2 - t1, "total": t2 - t0,
+            "last_final": float(xf[-1, -1]), "first_final": float(xf[0, -1])}
+
+
+def ladder_scipy(n: int) -> float:
+    """scipy BDF with the sparse (tridiagonal) Jacobian; seconds."""
+    from scipy.integrate import solve_ivp
+    from scipy.sparse import diags
+
+    i = np.arange(1, n + 1, dtype=float)
+
+    def rhs(t, v):
+        prev = np.concatenate([[math.sin(2 * math.pi * 10.0 * t)], v[:-1]])
+        cur = i * (prev - v)
+        return i ** 2 * (cur - np.concatenate([cur[1:], [0.0]]))
+
+    main = -(i ** 2) * (i + np.concatenate([i[1:], [0.0]]))
+    upper = (i[:-1] ** 2) * i[1:]
+    lower = (i[1:] ** 2) * i[1:]
+    jac = diags([lower, main, upper], [-1, 0, 1], format="csc")
+    t0 = time.perf_counter()
+    solve_ivp(rhs, (0.0, STOP), i, method="BDF", rtol=RTOL, atol=ATOL, jac=jac,
+              t_eval=np.linspace(0.0, STOP, int(round(STOP / DT)) + 1))
+    return time.perf_counter() - t0
+
+
+def rc_ladder_rows(sizes: list[int], scipy_up_to: int) -> list[dict]:
+    from rc_ladder import run
+
+    rows = []
+    for n in sizes:
+        ours = run(n)
+        hand = ladder_by_hand(n)
+        row = {"n": n, "bgmodelica_build": ours["build"], "bgmodelica_solve": ours["solve"],
+               "bgmodelica_total": ours["total"], "casadi_cvodes_total": hand["total"],
+               "ratio_vs_casadi": ours["total"] / hand["total"]}
+        if n <= scipy_up_to:
+            row["scipy_bdf_total"] = ladder_scipy(n)
+            row["ratio_scipy_vs_bgmodelica"] = row["scipy_bdf_total"] / ours["total"]
+        rows.append(row)
+        print(f"  RC ladder n={n}: bgmodelica {ours['total']:.3f} s (build "
+              f"{ours['build']:.3f}), CasADi/CVODES by hand {hand['total']:.3f} s, ratio "
+              f"{row['ratio_vs_casadi']:.2f}", flush=True)
+    return rows
+
+
+def compile_rows(sizes: list[int]) -> dict:
+    from compile_scaling import measure
+    from rc_ladder import rc_ladder
+
+    measure(rc_ladder, 10)                                   # warm: unit registry, imports
+    rows = []
+    for n in sizes:
+        n_eq, secs, _ = measure(rc_ladder, n)
+        rows.append({"cells": n, "equations": n_eq, "seconds": secs,
+                     "us_per_equation": 1e6 * secs / n_eq})
+        print(f"  compile: {n_eq} equations in {secs:.3f} s ({rows[-1]['us_per_equation']:.1f} "
+              "us/eq)", flush=True)
+    k = float(np.polyfit(np.log([r["equations"] for r in rows]),
+                         np.log([r["seconds"] for r in rows]), 1)[0]) if len(rows) > 1 else None
+    return {"rows": rows, "growth_exponent": k}
+
+
+def robot(repeat: int) -> dict:
+    from robot_speed import main as robot_main
+
+    r = robot_main(repeat)
+    out = dict(r)
+    out["ratio_idas_vs_casadi"] = r["idas"] / r["casadi"]
+    out["ratio_cvodes_vs_casadi"] = r["cvodes"] / r["casadi"]
+    out["ratio_auto_vs_casadi"] = r["dynamic"] / r["casadi"]
+    return out
+
+
+def master_vs_container(stop_time: float, repeat: int) -> dict:
+    from bgmodelica.cosim.master import Master
+    from bgmodelica.cosim.xcheck import build_container, run_container
+    from library.robots.subsystems import build_robot_fmus, robot_system
+
+    def best(fn) -> float:
+        b = math.inf
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            fn()
+            b = min(b, time.perf_counter() - t0)
+        return b
+
+    with tempfile.TemporaryDirectory(prefix="bgm_run_all_") as tmp:
+        system = robot_system(dict(build_robot_fmus(Path(tmp) / "fmu")))
+        master = Master(system)
+        jac = best(lambda: master.simulate(stop_time, 1e-3)) / stop_time
+        gs = best(lambda: master.simulate(stop_time, 1e-3, order="gauss-seidel")) / stop_time
+        try:
+            container = build_container(system, Path(tmp) / "container", step_size=1e-3)
+            cont = best(lambda: run_container(container, stop_time, 1e-3)) / stop_time
+        except Exception as err:  # noqa: BLE001 - fmu-manipulation-toolbox is optional
+            print(f"  fmucontainer unavailable: {err}")
+            cont = None
+    out = {"master_jacobi_s_per_s": jac, "master_gauss_seidel_s_per_s": gs,
+           "fmucontainer_s_per_s": cont,
+           "ratio_jacobi_vs_container": jac / cont if cont else None}
+    print(f"  master {jac:.4f} s/s (Jacobi), {gs:.4f} (Gauss-Seidel); fmucontainer "
+          f"{cont if cont is None else round(cont, 4)} s/s", flush=True)
+    return out
+
+
+def table(report: dict) -> str:
+    """The README's performance table (Markdown) from a report."""
+    lines = ["| benchmark | bgmodelica | baseline (same run) | ratio | target |",
+             "|---|---:|---:|---:|---|"]
+    for r in report["rc_ladder"]:
+        lines.append(f"| RC ladder n = {r['n']:,}, build + 10-s solve | "
+                     f"{r['bgmodelica_total']:.3f} s | CasADi/CVODES by hand "
+                     f"{r['casadi_cvodes_total']:.3f} s | {r['ratio_vs_casadi']:.2f}x | "
+                     f"{'<= 2.5x' if r['n'] == 10000 else ('< 0.5 s' if r['n'] == 1000 else '')}"
+                     " |")
+    comp = report["compile"]
+    for r in comp["rows"]:
+        lines.append(f"| compile, {r['equations']:,} equations | {r['seconds']:.3f} s | | "
+                     f"{r['us_per_equation']:.1f} us/eq | <= 20 us/eq at 1e5 |")
+    if comp["growth_exponent"] is not None:
+        lines.append(f"| compile growth exponent | {comp['growth_exponent']:.2f} | | | <= 1.1 |")
+    rb = report["robot"]
+    lines.append(f"| robot 10 s, `simulate` (IDAS, default) | {rb['idas'] * 1e3:.1f} ms | "
+                 f"CasADi/CVODES by hand {rb['casadi'] * 1e3:.1f} ms | "
+                 f"{rb['ratio_idas_vs_casadi']:.2f}x | <= 1.5x |")
+    lines.append(f"| robot 10 s, `simulate(solver=\"auto\")` (CVODES) | "
+                 f"{rb['dynamic'] * 1e3:.1f} ms | CasADi/CVODES by hand "
+                 f"{rb['casadi'] * 1e3:.1f} ms | "
+                 f"{rb['ratio_auto_vs_casadi']:.2f}x | |")
+    lines.append(f"| robot compile | {rb['build'] * 1e3:.0f} ms | | | < 300 ms |")
+    mc = report.get("cosim")
+    if mc and mc.get("fmucontainer_s_per_s"):
+        lines.append(f"| co-simulation master, robot split, 1 ms (Jacobi) | "
+                     f"{mc['master_jacobi_s_per_s']:.3f} s/s | fmucontainer "
+                     f"{mc['fmucontainer_s_per_s']:.3f} s/s | "
+                     f"{mc['ratio_jacobi_vs_container']:.2f}x | <= 2x |")
+    return "\n".join(lines)
+
+
+def rewrite_readme(path: Path, text: str, stamp: str) -> None:
+    doc = path.read_text()
+    if MARK_START not in doc or MARK_END not in doc:
+        raise SystemExit(f"{path} has no {MARK_START} ... {MARK_END} section")
+    head, rest = doc.split(MARK_START, 1)
+    _, tail = rest.split(MARK_END, 1)
+    path.write_text(f"{head}{MARK_START}\n{stamp}\n\n{text}\n{MARK_END}{tail}")
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--full", action="store_true", help="the acceptance sizes (long)")
+    ap.add_argument("--json", default="perf.json", help="where to write the report")
+    ap.add_argument("--readme", action="store_true",
+                    help="rewrite the README's performance table from this run")
+    ap.add_argument("--repeat", type=int, default=3)
+    args = ap.parse_args()
+    sizes = [100, 1000, 10000, 100000] if args.full else [100, 1000]
+    cells = [120, 1200, 12000] if args.full else [120, 1200]
+    t0 = time.perf_counter()
+    print("RC ladder", flush=True)
+    report: dict = {"mode": "full" if args.full else "quick",
+                    "machine": {"python": platform.python_version(),
+                                "processor": platform.machine()},
+                    "rc_ladder": rc_ladder_rows(sizes, scipy_up_to=1000)}
+    print("compile scaling", flush=True)
+    report["compile"] = compile_rows(cells)
+    print("robot", flush=True)
+    report["robot"] = robot(args.repeat)
+    print("co-simulation master", flush=True)
+    report["cosim"] = master_vs_container(2.0, args.repeat)
+    report["seconds"] = time.perf_counter() - t0
+    Path(args.json).write_text(json.dumps(report, indent=2) + "\n")
+    text = table(report)
+    print(text)
+    print(f"-> {args.json} ({report['seconds']:.0f} s)")
+    if args.readme:
+        stamp = (f"Generated by `python benchmarks/run_all.py{' --full' if args.full else ''} "
+                 "--readme` (one run; ratios against baselines measured in the same run).")
+        rewrite_readme(HERE.parent / "README.md", text, stamp)
+        print("README performance table rewritten")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
