@@ -178,24 +178,34 @@ class ModelExchangeUnit(_Unit):
         self.terminated = True
         self.stop_reason = why
 
-    def _locate(self, dense: Any, ta: float, tb: float, za: np.ndarray, zb: np.ndarray,
+    def _locate(self, state_at: Any, ta: float, tb: float, za: np.ndarray, zb: np.ndarray,
                 args: tuple) -> float:
-        """The time just after the first crossing in ``(ta, tb]`` (Illinois; ``dense(t)``
-        gives the state at t, the FMU the indicators)."""
+        """The time just after the first crossing in ``(ta, tb]``: the Illinois method (false
+        position whose endpoint value is halved when that endpoint is kept twice), each trial
+        kept within the middle 80 % of the bracket. ``state_at(t)`` gives the state at t, the
+        FMU the indicators."""
         tol = self.event_tol * max(1.0, abs(tb))
+        fa, fb = za.copy(), zb.copy()            # the (possibly halved) values for the secant
+        kept = 0                                 # -1: a kept last time, +1: b kept
         while tb - ta > tol:
             crossed = np.flatnonzero(_crossed(za, zb))
-            # the earliest linear estimate over the crossing indicators picks the next split
+            # the earliest secant estimate over the crossing indicators picks the next split
             cand = []
             for i in crossed:
-                d = zb[i] - za[i]
-                cand.append(ta - za[i] * (tb - ta) / d if d != 0 else 0.5 * (ta + tb))
+                d = fb[i] - fa[i]
+                cand.append(ta - fa[i] * (tb - ta) / d if d != 0 else 0.5 * (ta + tb))
             tm = min(max(min(cand), ta + 0.1 * (tb - ta)), tb - 0.1 * (tb - ta))
-            zm = self._indicators(tm, dense(tm), *args)
+            zm = self._indicators(tm, state_at(tm), *args)
             if _crossed(za, zm).any():
-                tb, zb = tm, zm
+                tb, zb, fb = tm, zm, zm.copy()
+                if kept == -1:
+                    fa = 0.5 * fa
+                kept = -1
             else:
-                ta, za = tm, zm
+                ta, za, fa = tm, zm, zm.copy()
+                if kept == 1:
+                    fb = 0.5 * fb
+                kept = 1
         return tb
 
     # the step ---------------------------------------------------------------------------------
