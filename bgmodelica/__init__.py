@@ -6,6 +6,7 @@ Public API::
         Input, Output, StateSelect, connect, der, time, compile, simulate
 """
 
+from .core.arrays import ArrayExpr, array_of
 from .core.component import Component, Connection, Connector, connect
 from .core.expressions import (
     atan2,
@@ -64,7 +65,7 @@ __all__ = [
     "sin", "cos", "tan", "exp", "log", "sqrt", "atan2", "fabs", "tanh", "sign", "if_else",
     "fmin", "fmax", "Discrete", "Integer", "Boolean", "when", "reinit", "pre", "edge",
     "change", "initial", "terminal", "sample", "no_event", "noEvent", "eq", "and_", "or_",
-    "not_", "if_equation", "time_table",
+    "not_", "if_equation", "time_table", "array_of", "ArrayExpr",
 ]
 
 from .compiler import CompiledModel, compile  # noqa: E402

@@ -127,6 +127,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
 def cmd_check(args: argparse.Namespace) -> int:
     from .compiler import compile
+    from .core.arrays import compact_names
     from .loader import load_model
     from .validate import check_values
 
@@ -149,14 +150,15 @@ def cmd_check(args: argparse.Namespace) -> int:
     print(f"  flat equations {summary['flat_equations_before_alias_elimination']}, "
           f"aliases eliminated {summary['aliases_eliminated']}")
     print(f"  structural index: {summary['structural_index']}")
-    print(f"  states ({len(summary['states'])}): {', '.join(summary['states']) or '-'}")
+    print(f"  states ({len(summary['states'])}): "
+          f"{', '.join(compact_names(summary['states'])) or '-'}")
     if summary["dummy_derivatives"]:
-        print(f"  dummy derivatives: {', '.join(summary['dummy_derivatives'])}")
+        print(f"  dummy derivatives: {', '.join(compact_names(summary['dummy_derivatives']))}")
     if summary["differentiated_equations"]:
         print(f"  differentiated equations ({len(summary['differentiated_equations'])}): "
               + "; ".join(summary["differentiated_equations"][:8]))
     print(f"  algebraic variables ({len(summary['algebraic_variables'])}): "
-          + (", ".join(summary["algebraic_variables"][:20]) or "-"))
+          + (", ".join(compact_names(summary["algebraic_variables"])[:20]) or "-"))
     loops = summary["algebraic_loops"]
     print(f"  algebraic loops: {len(loops)}"
           + "".join(f"\n    size {lp['size']} ({lp['kind']}), tearing: "

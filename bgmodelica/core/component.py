@@ -21,13 +21,24 @@ makes it a guess). A dotted modifier reaches into subcomponents (``Motor(**{"R.R
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 import casadi as ca
+import numpy as np
 
 from ..errors import ConnectError, DeclarationError, DuplicateNameError
-from .expr import Leaf
+from .arrays import (
+    ArrayEquation,
+    ArrayExpr,
+    ComponentArray,
+    ElementArray,
+    connect_arrays,
+    element_names,
+    element_values,
+    normalize_shape,
+)
+from .expr import Expr, Leaf
 from .variables import (
     KIND_FLOW,
     KIND_INPUT,
@@ -73,6 +84,9 @@ class Element:
         nested = {k: v for k, v in modifiers.items() if "." in k}
         local = {k: v for k, v in modifiers.items() if "." not in k}
         for key, decl in type(self)._declarations.items():
+            if decl.shape != ():
+                self._declare_array(key, decl, local.pop(key, None))
+                continue
             if key in local:
                 decl = decl.with_start(local.pop(key))
             sym = Symbol(key, decl, self)
@@ -90,16 +104,76 @@ class Element:
         if nested:
             self.modify(**nested)
 
+    def _declare_array(self, key: str, decl: Declaration, modifier: Any) -> None:
+        """The scalars ``key[1] .. key[n]`` of an array declaration, and ``self.key`` as
+        their :class:`~bgmodelica.core.arrays.ArrayExpr`."""
+        where = f"{type(self).__name__}.{key}"
+        shape = decl.shape
+        if isinstance(shape, str):
+            if not isinstance(getattr(self, shape, None), (int, np.integer)):
+                raise DeclarationError(
+                    f"{where}: shape {shape!r} names no integer attribute; set self.{shape} "
+                    "before super().__init__()")
+            shape = getattr(self, shape)
+        shape = normalize_shape(shape, where)
+        scalar = replace(decl, shape=())
+        per_field = {f: element_values(getattr(decl, f), shape, where)
+                     for f in ("value", "start", "nominal", "min", "max")
+                     if hasattr(decl, f) and getattr(decl, f) is not None
+                     and not np.isscalar(getattr(decl, f))
+                     and not isinstance(getattr(decl, f), Expr)}
+        mods = element_values(modifier, shape, where) if modifier is not None else None
+        leaves = []
+        for k, name in enumerate(element_names(key, shape)):
+            elem = replace(scalar, **{f: v[k] for f, v in per_field.items()}) if per_field \
+                else scalar
+            if mods is not None:
+                elem = elem.with_start(mods[k])
+            sym = Symbol(name, elem, self)
+            self._symbols[name] = sym
+            leaves.append(sym.leaf)
+        items = np.empty(len(leaves), dtype=object)
+        items[:] = leaves
+        self.__dict__.setdefault("_arrays", {})[key] = shape
+        object.__setattr__(self, key, ArrayExpr(items.reshape(shape)))
+
+    def declare(self, name: str, decl: Declaration) -> Any:
+        """Add a parameter or variable (scalar or array) to this instance, e.g. in
+        ``__init__`` when its shape is a constructor argument; returns ``self.name``."""
+        if not isinstance(decl, Declaration):
+            raise DeclarationError(f"declare({name!r}, ...) needs a Parameter or Variable, "
+                                   f"got {decl!r}")
+        if name in self._symbols or name in self._children or name in self.__dict__:
+            raise DuplicateNameError(f"{type(self).__name__}: {name!r} is already declared")
+        if decl.shape != ():
+            self._declare_array(name, decl, None)
+        else:
+            sym = Symbol(name, decl, self)
+            self._symbols[name] = sym
+            object.__setattr__(self, name, sym.leaf)
+        return getattr(self, name)
+
     # -- structure -----------------------------------------------------------------------
     def add(self, name: str, element: Element) -> Element:
-        """Add a subcomponent or connector under ``name`` and return it."""
+        """Add a subcomponent or connector under ``name`` and return it; a
+        :class:`~bgmodelica.core.arrays.ComponentArray` adds its elements as
+        ``name[1] .. name[n]``."""
+        if isinstance(element, ComponentArray):
+            for k, item in enumerate(element):
+                self._add(f"{name}[{k + 1}]", item, check_name=False)
+            self.__dict__.setdefault("_arrays", {})[name] = (len(element),)
+            object.__setattr__(self, name, element)
+            return element   # type: ignore[return-value]
+        return self._add(name, element)
+
+    def _add(self, name: str, element: Element, check_name: bool = True) -> Element:
         if not isinstance(element, Element):
             raise DeclarationError(f"{name!r} is not a component or connector: {element!r}")
         if name in self._children or name in self._symbols:
             raise DuplicateNameError(
                 f"{type(self).__name__} {self._name or ''}: a subcomponent or variable named "
                 f"{name!r} already exists")
-        if not name.isidentifier():
+        if check_name and not name.isidentifier():
             raise DeclarationError(f"{name!r} is not a valid component name")
         if name not in type(self)._templates and callable(getattr(type(self), name, None)) \
                 or isinstance(getattr(type(self), name, None), property):
@@ -108,13 +182,15 @@ class Element:
                 "of the class; choose another name")
         object.__setattr__(element, "_name", name)
         self._children[name] = element
-        object.__setattr__(self, name, element)
+        if check_name:
+            object.__setattr__(self, name, element)
         return element
 
     def __setattr__(self, name: str, value: Any) -> None:
-        if isinstance(value, Element) and not name.startswith("_"):
+        if isinstance(value, (Element, ComponentArray)) and not name.startswith("_"):
             self.add(name, value)
-        elif name in self.__dict__.get("_symbols", {}):
+        elif name in self.__dict__.get("_symbols", {}) or name in self.__dict__.get("_arrays",
+                                                                                  {}):
             self.modify(**{name: value})
         else:
             object.__setattr__(self, name, value)
@@ -131,6 +207,15 @@ class Element:
             elif head in self._symbols:
                 sym = self._symbols[head]
                 sym.decl = sym.decl.with_start(value)
+            elif head in self.__dict__.get("_arrays", {}):
+                shape = self._arrays[head]
+                names = element_names(head, shape)
+                values = element_values(value, shape, f"{type(self).__name__}.{head}")
+                for name, v in zip(names, values, strict=True):
+                    if name in self._symbols:
+                        self._symbols[name].decl = self._symbols[name].decl.with_start(v)
+                    else:
+                        self._children[name].modify(**_as_modifiers(name, v))
             elif head in self._children:
                 self._children[head].modify(**_as_modifiers(head, value))
             else:
@@ -201,8 +286,11 @@ class Connection:
     b: Any
 
 
-def connect(a: Any, b: Any) -> Connection:
-    """Join two connectors (potentials equal, flows sum to zero) or two signals."""
+def connect(a: Any, b: Any) -> Any:
+    """Join two connectors (potentials equal, flows sum to zero) or two signals; arrays of
+    connectors or signals are joined elementwise (a list of :class:`Connection`)."""
+    if isinstance(a, (ElementArray, ArrayExpr)) or isinstance(b, (ElementArray, ArrayExpr)):
+        return connect_arrays(_as_array(a), _as_array(b), connect)
     check_connectable(a, b)
     return Connection(a, b)
 
@@ -261,6 +349,10 @@ def check_connectable(a: Any, b: Any) -> None:
                            f"{_qualified(syms[1])} (an output is connected to inputs)")
 
 
+def _as_array(x: Any) -> Any:
+    return ElementArray(list(x)) if isinstance(x, ArrayExpr) else x
+
+
 def _qualified(sym: Symbol) -> str:
     owner = getattr(sym.owner, "name", None)
     return f"{owner}.{sym.name}" if owner else sym.name
@@ -305,18 +397,34 @@ class Component(Element):
 
     def connect(self, a: Any, b: Any) -> None:
         """Imperative form of ``connect`` for models assembled in code."""
-        self._equations.append(connect(a, b))
+        made = connect(a, b)
+        if isinstance(made, list):
+            self._equations.extend(made)
+        else:
+            self._equations.append(made)
 
     def equation(self, *eqs: Any) -> None:
         """Imperative form: add equations ``lhs == rhs`` to this component."""
         self._equations.extend(eqs)
 
     def all_equations(self) -> Iterator[Any]:
-        """Equations of every class in the hierarchy (base classes first), then added ones."""
+        """Equations of every class in the hierarchy (base classes first), then added ones;
+        array equations and lists of connections come out as their scalar items."""
         for cls in reversed(type(self).__mro__):
             own = vars(cls).get("equations")
             if own is not None:
                 result = own(self)
                 if result is not None:
-                    yield from result
-        yield from self._equations
+                    yield from _scalar_items(result)
+        yield from _scalar_items(self._equations)
+
+
+def _scalar_items(items: Iterable[Any]) -> Iterator[Any]:
+    """Equations and connections, with array equations and lists of them expanded."""
+    for item in items:
+        if isinstance(item, ArrayEquation):
+            yield from item.equations()
+        elif isinstance(item, list) and item and all(isinstance(c, Connection) for c in item):
+            yield from item
+        else:
+            yield item

@@ -73,6 +73,16 @@ class Expr:
         return to_text(self)
 
 
+class ArrayBase:
+    """Base of array expressions (:class:`bgmodelica.core.arrays.ArrayExpr`): math functions
+    and ``der`` apply elementwise through :meth:`map`."""
+
+    __slots__ = ()
+
+    def map(self, fun: Callable[[Any], Any]) -> Any:
+        raise NotImplementedError
+
+
 class Leaf(Expr):
     """A declared scalar (variable, parameter, derivative) or ``time``."""
 
@@ -139,6 +149,8 @@ def _unary(name: str) -> Callable[[Any], Any]:
     def fun(x: Any) -> Any:
         if isinstance(x, Expr):
             return Op(name, (x,))
+        if isinstance(x, ArrayBase):
+            return x.map(fun)
         if isinstance(x, Number):
             return float(np_fun(x))
         return sx_fun(x)
@@ -157,6 +169,8 @@ def fabs(x: Any) -> Any:
     """Absolute value."""
     if isinstance(x, Expr):
         return Op("fabs", (x,))
+    if isinstance(x, ArrayBase):
+        return x.map(fabs)
     return abs(float(x)) if isinstance(x, Number) else ca.fabs(x)
 
 
@@ -164,6 +178,8 @@ def sign(x: Any) -> Any:
     """Sign (-1, 0, 1)."""
     if isinstance(x, Expr):
         return Op("sign", (x,))
+    if isinstance(x, ArrayBase):
+        return x.map(sign)
     return float(np.sign(x)) if isinstance(x, Number) else ca.sign(x)
 
 

@@ -8,6 +8,7 @@ import casadi as ca
 
 from ..errors import EquationError
 from .expr import (
+    ArrayBase,
     Expr,
     Leaf,
     Number,
@@ -41,6 +42,8 @@ def der(expr: Any) -> Any:
     """Time derivative of a variable or of an expression of variables, parameters and time."""
     if isinstance(expr, Number):
         return 0.0
+    if isinstance(expr, ArrayBase):
+        return expr.map(der)
     if isinstance(expr, Expr):
         return differentiate(expr, _rate)
     if isinstance(expr, (ca.SX, ca.MX)):

@@ -48,6 +48,10 @@ class Declaration:
 
     unit: str = ""
     description: str = ""
+    #: array shape: () for a scalar, an int or tuple of ints for an array (elements named
+    #: ``x[1] .. x[n]``), or the name of an integer attribute of the instance (``"n"``) set
+    #: before ``super().__init__`` (see :mod:`bgmodelica.core.arrays`)
+    shape: Any = ()
     kind = KIND_VARIABLE
 
     def with_start(self, value: Any) -> Declaration:

@@ -7,11 +7,12 @@ Each is a :class:`bgmodelica.Component` class (``RCLadder`` takes the number of 
     result = bg.simulate(RC(), stop_time=5.0)
 """
 
-from .circuits import RC, RCLadder, SeriesRLC
+from .circuits import RC, RCLadder, RCLadderArrays, RCLadderVector, SeriesRLC
 from .mechanics import GearedInertias, TorsionOscillator
 from .motors import DCMotor, PIDSpeedControl
 
-__all__ = ["RC", "SeriesRLC", "RCLadder", "DCMotor", "PIDSpeedControl", "GearedInertias",
+__all__ = ["RC", "SeriesRLC", "RCLadder", "RCLadderArrays", "RCLadderVector",
+           "DCMotor", "PIDSpeedControl", "GearedInertias",
            "TorsionOscillator"]
 
 #: Every example by name, with the constructor to call.

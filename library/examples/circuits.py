@@ -1,8 +1,13 @@
-"""Example circuits: RC charging, underdamped series RLC, the SciML RC ladder."""
+"""Example circuits: RC charging, underdamped series RLC, the SciML RC ladder (a component
+per section, an array of components, and array equations)."""
 
 from __future__ import annotations
 
-from bgmodelica import Component, connect
+import math
+
+import numpy as np
+
+from bgmodelica import Component, Parameter, Variable, array_of, connect, der, sin, time
 from library.electrical import (
     Capacitor,
     ConstantVoltage,
@@ -12,7 +17,7 @@ from library.electrical import (
     SineVoltage,
 )
 
-__all__ = ["RC", "SeriesRLC", "RCLadder"]
+__all__ = ["RC", "SeriesRLC", "RCLadder", "RCLadderArrays", "RCLadderVector"]
 
 
 class RC(Component):
@@ -83,3 +88,65 @@ class RCLadder(Component):
             self.connect(resistor.n, capacitor.p)
             self.connect(capacitor.n, self.ground.p)
             node = resistor.n
+
+
+def _ladder_values(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """R_k = 1/k Ohm, C_k = 1/k^2 F, v_k(0) = k V for k = 1..n."""
+    k = np.arange(1, n + 1, dtype=float)
+    return 1.0 / k, 1.0 / k**2, k
+
+
+class RCLadderArrays(Component):
+    """:class:`RCLadder` built from arrays of components: ``R[1..n]`` and ``C[1..n]``
+    (``R[k].R = 1/k``, ``C[k].C = 1/k^2``, ``C[k].v(0) = k``), connected array-wise.
+    Same equations, same results as :class:`RCLadder` (its ``Ck.v`` is ``C[k].v`` here)."""
+
+    def __init__(self, n: int = 10, **modifiers):
+        super().__init__(**modifiers)
+        if n < 1:
+            raise ValueError("RCLadderArrays needs n >= 1 sections")
+        r, c, v0 = _ladder_values(n)
+        self.source = SineVoltage(V=1.0, f=10.0)
+        self.ground = Ground()
+        self.R = array_of(Resistor, n, R=r)
+        self.C = array_of(Capacitor, n, C=c, v=v0)
+        self.connect(self.source.n, self.ground.p)
+        self.connect(self.source.p, self.R[0].p)
+        self.connect(self.R.n[:-1], self.R.p[1:])      # the series chain
+        self.connect(self.R.n, self.C.p)
+        self.connect(self.C.n, self.ground.p)           # one connector, broadcast
+
+
+class RCLadderVector(Component):
+    """:class:`RCLadder` as array equations on node voltages ``v[1..n]`` [V] and resistor
+    currents ``i[1..n]`` [A] (``R[k] = 1/k`` Ohm, ``C[k] = 1/k^2`` F, ``v[k](0) = k`` V;
+    source ``V*sin(2*pi*f*time)``, V = 1 V, f = 10 Hz)::
+
+        i[1]      = (V*sin(2*pi*f*t) - v[1]) / R[1]
+        i[2:n]    = (v[1:n-1] - v[2:n]) / R[2:n]
+        C*der(v)  = i - [i[2:n], 0]
+
+    Its ``v[k]`` is ``Ck.v`` of :class:`RCLadder`; ``i[k]`` is ``Rk.i``.
+    """
+
+    v = Variable(shape="n", unit="V", description="node voltage (capacitor voltage)")
+    i = Variable(shape="n", unit="A", description="resistor current")
+    R = Parameter(shape="n", value=1.0, unit="Ohm", description="section resistance")
+    C = Parameter(shape="n", value=1.0, unit="F", description="section capacitance")
+    V = Parameter(1.0, unit="V", description="source amplitude")
+    f = Parameter(10.0, unit="Hz", description="source frequency")
+
+    def __init__(self, n: int = 10, **modifiers):
+        if n < 1:
+            raise ValueError("RCLadderVector needs n >= 1 sections")
+        self.n = n
+        r, c, v0 = _ladder_values(n)
+        super().__init__(**{"R": r, "C": c, "v": v0, **modifiers})
+
+    def equations(self):
+        v, i = self.v, self.i
+        yield i[0] == (self.V * sin(2 * math.pi * self.f * time) - v[0]) / self.R[0]
+        if self.n > 1:
+            yield i[1:] == (v[:-1] - v[1:]) / self.R[1:]
+            yield self.C[:-1] * der(v[:-1]) == i[:-1] - i[1:]
+        yield self.C[-1] * der(v[-1]) == i[-1]

@@ -1,0 +1,142 @@
+"""Array variables, parameters, equations and arrays of components, against analytic
+solutions and against the same models written one scalar at a time."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy.linalg import expm
+
+import bgmodelica as bg
+from bgmodelica import Component, Parameter, Variable, array_of, der
+from bgmodelica.core.arrays import compact_names, element_names
+from bgmodelica.errors import ConnectError, DeclarationError, EquationError
+from library.electrical import Capacitor, Ground, Resistor
+from library.examples import RCLadder, RCLadderArrays, RCLadderVector
+
+TIGHT = {"rtol": 1e-10, "atol": 1e-12}
+
+
+class Decay(Component):
+    """der(x[k]) = -a[k]*x[k], x[k](0) = x0[k]: x[k](t) = x0[k]*exp(-a[k]*t)."""
+
+    x = Variable(shape=3, start=[1.0, 2.0, 3.0], fixed=True)
+    a = Parameter(shape=3, value=[0.5, 1.0, 2.0], unit="1/s")
+
+    def equations(self):
+        yield der(self.x) == -self.a * self.x
+
+
+class Linear2(Component):
+    """der(x) = A x with a 2x2 parameter matrix: x(t) = expm(A t) x0."""
+
+    x = Variable(shape=2, start=[1.0, 0.0], fixed=True)
+    A = Parameter(shape=(2, 2), value=[[0.0, 1.0], [-4.0, -0.4]], unit="1/s")
+
+    def equations(self):
+        yield der(self.x) == self.A @ self.x
+
+
+def test_vector_decay_matches_exponentials():
+    res = bg.simulate(Decay(), stop_time=2.0, interval=0.1, **TIGHT)
+    for k, (x0, a) in enumerate(zip([1.0, 2.0, 3.0], [0.5, 1.0, 2.0], strict=True)):
+        assert np.max(np.abs(res[f"x[{k + 1}]"] - x0 * np.exp(-a * res.time))) < 1e-8
+
+
+def test_parameter_array_override_by_element_name():
+    res = bg.simulate(Decay(), stop_time=1.0, interval=0.5, params={"a[2]": 3.0}, **TIGHT)
+    assert res["x[2]"][-1] == pytest.approx(2.0 * np.exp(-3.0), rel=1e-8)
+    assert res["x[1]"][-1] == pytest.approx(np.exp(-0.5), rel=1e-8)
+
+
+def test_array_modifier_at_construction():
+    res = bg.simulate(Decay(x=[4.0, 5.0, 6.0], a=2.0), stop_time=1.0, interval=0.5, **TIGHT)
+    assert res["x[3]"][-1] == pytest.approx(6.0 * np.exp(-2.0), rel=1e-8)
+
+
+def test_matrix_parameter_and_matmul_match_expm():
+    res = bg.simulate(Linear2(), stop_time=3.0, interval=0.5, **TIGHT)
+    A = np.array([[0.0, 1.0], [-4.0, -0.4]])
+    for t, x1, x2 in zip(res.time, res["x[1]"], res["x[2]"], strict=True):
+        ref = expm(A * t) @ np.array([1.0, 0.0])
+        assert abs(x1 - ref[0]) < 1e-8 and abs(x2 - ref[1]) < 1e-8
+    assert "A[1,2]" in res.parameters
+
+
+@pytest.mark.parametrize("n", [1, 2, 9])
+def test_three_ladder_forms_agree_exactly(n):
+    runs = [bg.simulate(M(n), stop_time=0.5, interval=0.05, **TIGHT)
+            for M in (RCLadder, RCLadderArrays, RCLadderVector)]
+    ref = runs[0][f"C{n}.v"]
+    assert np.max(np.abs(runs[1][f"C[{n}].v"] - ref)) < 1e-12
+    assert np.max(np.abs(runs[2][f"v[{n}]"] - ref)) < 1e-12
+    assert np.max(np.abs(runs[2]["i[1]"] - runs[0]["R1.i"])) < 1e-9
+
+
+def test_single_section_ladder_is_the_analytic_rc():
+    """n = 1: C v' = (sin(20 pi t) - v)/R with R = C = 1, v(0) = 1."""
+    res = bg.simulate(RCLadderVector(1), stop_time=1.0, interval=0.01, **TIGHT)
+    w = 20 * np.pi
+    t = res.time
+    forced = (np.sin(w * t) - w * np.cos(w * t)) / (1 + w**2)
+    exact = forced + (1.0 + w / (1 + w**2)) * np.exp(-t)
+    assert np.max(np.abs(res["v[1]"] - exact)) < 1e-8
+
+
+def test_element_names_and_compact_names():
+    assert element_names("x", (3,)) == ["x[1]", "x[2]", "x[3]"]
+    assert element_names("A", (2, 2)) == ["A[1,1]", "A[1,2]", "A[2,1]", "A[2,2]"]
+    names = ["v[1]", "v[2]", "v[3]", "w", "C[1].v", "C[2].v", "C[4].v", "der(x[1])"]
+    assert compact_names(names) == ["v[1:3]", "w", "C[1:2].v", "C[4].v", "der(x[1])"]
+
+
+def test_array_of_components_connect_broadcast_and_mismatch():
+    class Chain(Component):
+        def __init__(self):
+            super().__init__()
+            self.g = Ground()
+            self.R = array_of(Resistor, 3, R=[1.0, 2.0, 3.0])
+            self.C = array_of(Capacitor, 3, C=1.0, v=[1.0, 2.0, 3.0])
+            self.connect(self.R.n, self.C.p)
+            self.connect(self.C.n, self.g.p)
+            self.connect(self.R.p, self.g.p)
+
+    m = Chain()
+    assert [c.name for c in m.R] == ["R[1]", "R[2]", "R[3]"]
+    res = bg.simulate(m, stop_time=1.0, interval=0.5, **TIGHT)
+    for k in (1, 2, 3):      # each C[k] discharges through R[k]: tau = R[k]*1 F
+        assert res[f"C[{k}].v"][-1] == pytest.approx(k * np.exp(-1.0 / k), rel=1e-8)
+    with pytest.raises(ConnectError, match="3 and 2 connectors"):
+        m.connect(m.R.p, m.C.n[:2])
+
+
+def test_shape_from_missing_attribute_is_named():
+    class Bad(Component):
+        x = Variable(shape="m")
+
+    with pytest.raises(DeclarationError, match="Bad.x: shape 'm' names no integer"):
+        Bad()
+    with pytest.raises(DeclarationError, match="shape 0"):
+        type("Zero", (Component,), {"x": Variable(shape=0)})()
+
+
+def test_mismatched_array_equation_names_the_component():
+    class Mismatch(Component):
+        x = Variable(shape=3)
+
+        def equations(self):
+            yield der(self.x[:2]) == self.x
+
+    with pytest.raises(EquationError, match=r"Mismatch.*\(2,\) and \(3,\)"):
+        bg.compile(Mismatch())
+
+
+def test_check_prints_arrays_compactly():
+    out = subprocess.run([sys.executable, "-m", "bgmodelica.cli", "check",
+                          "library.examples:RCLadderVector", "--arg", "n=40"],
+                         capture_output=True, text=True, check=True).stdout
+    assert "states (40): v[1:40]" in out
+    assert "100 equations" not in out and "80 equations" in out
