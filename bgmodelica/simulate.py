@@ -18,6 +18,7 @@ from .diagnose import check_initial_point, check_result, unsafe_outputs
 from .errors import ParameterError, SimulationError
 from .events.fast import Fast
 from .result import Result
+from .solver_options import integrator_settings
 from .validate import check_run_options, check_values, output_grid
 
 _HINTS = {
@@ -43,7 +44,8 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
              progress: Callable[[float], None] | None = None,
              inputs: Any = None, units: str = "error",
              sensitivities: Sequence[str] | None = None,
-             sensitivity_method: str = "forward", init: str = "start") -> Result:
+             sensitivity_method: str = "forward", init: str = "start",
+             linear_solver: str = "auto", jit: bool | str = False) -> Result:
     """Simulate ``model`` from ``start_time`` to ``stop_time`` [s].
 
     init: ``"start"`` (default): the initial conditions are the fixed start values and the
@@ -78,6 +80,13 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
     the event loop (:mod:`bgmodelica.events`): at every event the result holds two rows with
     the same time, the left and the right limit; ``result.meta["event_times"]`` lists them.
 
+    linear_solver: the direct solver of the Newton iterations: ``"auto"`` (sparse QR, measured
+    best at every size), ``"qr"``, ``"csparse"`` (sparse LU), ``"lapacklu"`` or
+    ``"lapackqr"`` (dense); jit: compile the model functions to C first (True, or an
+    optimization level "O1", "O2"; worth it for long or repeated runs, see
+    :mod:`bgmodelica.solver_options`). ``result.meta`` reports
+    ``linear_solver`` and ``jit``.
+
     sensitivities: parameters / inputs p_j to differentiate the recorded variables with
     respect to: ``result.sensitivity("rotor.w", "resistor.R")`` is d(rotor.w)/d(resistor.R)
     along ``result.time``. sensitivity_method: ``"forward"`` (CVODES/IDAS forward
@@ -99,6 +108,7 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
         raise ParameterError(f"solver 'cvodes' cannot handle the {dae.z.numel()} algebraic "
                              f"unknown(s) left in {compiled.name} (e.g. {dae.algebraic_names[0]}); "
                              "use solver='idas' or 'auto'")
+    extra, solver_meta = integrator_settings(dae.x.numel() + dae.z.numel(), linear_solver, jit)
     t_start = _time.perf_counter()
     params = with_units(params or {}, compiled)
     p_over, start_over = _split_overrides(dae, params)
@@ -132,18 +142,20 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
             result = simulate_hybrid(compiled, dae, p, grid, rtol=rtol, atol=atol,
                                      max_step=max_step, max_steps=max_steps, outputs=outputs,
                                      inputs=inputs, t_start=t_start, selection=selection,
-                                     progress=progress)
+                                     progress=progress, solver_options=extra)
         except SimulationError as err:      # NaN / Inf in the rows computed: say where
             if err.result is not None:
                 check_result(err.result, dae, p)
             raise
         check_result(result, dae, p)
+        result.meta.update(solver_meta)
         return result
     init = initialize(dae, p, start_time)
     check_initial_point(dae, init.x0, init.z0, p, start_time)
     obs_idx = _output_indices(dae, outputs, compiled.reduced.model.aliases)
     opts = {"abstol": atol, "reltol": rtol, "max_num_steps": max_steps,
-            "calc_ic": False}   # initialize() already made x0, z0 consistent
+            "calc_ic": False,   # initialize() already made x0, z0 consistent
+            **extra}
     if max_step is not None:
         opts["max_step_size"] = float(max_step)
     xs, zs, stats, failure = _integrate(dae, solver, grid, init.x0, init.z0, p, opts,
@@ -159,7 +171,7 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
     params_out = dae.parameter_values(p)
     meta = {"compile_seconds": compiled.compile_time, "run_seconds": run,
             "timings": dict(compiled.timings), "solver": solver, "solver_choice": choice,
-            "stats": stats,
+            **solver_meta, "stats": stats,
             "states": list(dae.state_names), "init_notes": init.notes}
     kept = set(names)
     aliases = {a: rep for a, rep in flat.aliases.items() if rep[0] in kept}
@@ -423,7 +435,7 @@ def _integrator(dae: CasadiDAE, solver: str, t0: float, tout: np.ndarray, opts: 
 def _cached_integrator(dae: CasadiDAE, solver: str, t0: float, tout: np.ndarray, opts: dict):
     """The integrator for these settings, reused by repeated runs of the same model."""
     key = ("integrator", solver, float(t0), tuple(map(float, tout)),
-           tuple(sorted((k, tuple(v) if isinstance(v, list) else v) for k, v in opts.items())))
+           tuple(sorted((k, repr(v)) for k, v in opts.items())))
     cache = dae.cache.setdefault("integrators", {})
     if key not in cache:
         if len(cache) >= 4:

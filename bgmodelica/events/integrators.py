@@ -37,7 +37,8 @@ def integrator(dae: CasadiDAE, opts: dict, tout: list[float], scaled: bool) -> c
     """CVODES (ODE) or IDAS (DAE) integrator of the model from ``t0``: over ``tau`` in [0, 1]
     with ``t = t0 + tau*dt`` when ``scaled`` (p = [p, t0, dt]), else over offsets ``tau``
     with ``t = t0 + tau`` (p = [p, t0]). Cached in ``dae.cache`` by its settings."""
-    key = ("hybrid_integrator", scaled, tuple(tout), tuple(sorted(opts.items())))
+    key = ("hybrid_integrator", scaled, tuple(tout),
+           tuple(sorted((k, repr(v)) for k, v in opts.items())))
     if key in dae.cache:
         return dae.cache[key]
     t0, dt, tau = ca.SX.sym("t0"), ca.SX.sym("dt"), ca.SX.sym("tau")

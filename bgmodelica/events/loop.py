@@ -85,8 +85,8 @@ class HybridSimulator:
 
     def __init__(self, dae: CasadiDAE, p: np.ndarray, rtol: float, atol: float,
                  max_step: float | None, max_steps: int, obs_idx: list[int],
-                 options: EventOptions | None = None, selection: Selection | None = None
-                 ) -> None:
+                 options: EventOptions | None = None, selection: Selection | None = None,
+                 solver_options: dict | None = None) -> None:
         if dae.hybrid is None:
             dae = replace(dae, hybrid=HybridPart())
         self.dae = dae
@@ -101,11 +101,12 @@ class HybridSimulator:
         sol_opts: dict[str, Any] = {"abstol": atol, "reltol": rtol, "max_num_steps": max_steps}
         if max_step is not None:
             sol_opts["max_step_size"] = float(max_step)
+        sol_opts.update(solver_options or {})
         self._step_fast = Fast(self.fn.step)
         self._ind_fast = Fast(self.fn.indicators)
         self.n_segments = 0
         self._sol_opts = sol_opts
-        self._opts_key = tuple(sorted(sol_opts.items()))
+        self._opts_key = tuple(sorted((k, repr(v)) for k, v in sol_opts.items()))
         self._one: ca.Function | None = None
         hyb = dae.hybrid or HybridPart()
         nb = dae.n_base

@@ -17,7 +17,7 @@ from .loop import HybridSimulator, Selection
 def simulate_hybrid(compiled, dae: CasadiDAE, p: np.ndarray, grid: np.ndarray, *, rtol: float,
                     atol: float, max_step: float | None, max_steps: int, outputs, inputs: Any,
                     t_start: float, selection: Selection | None = None,
-                    progress=None) -> Result:
+                    progress=None, solver_options: dict | None = None) -> Result:
     """Simulate a model with events, time-varying inputs or dynamic state selection over the
     output ``grid``."""
     if inputs is not None:
@@ -31,7 +31,7 @@ def simulate_hybrid(compiled, dae: CasadiDAE, p: np.ndarray, grid: np.ndarray, *
         prepare = selection.prepare
         selection.prepare = lambda d: with_input_tables(prepare(d) if prepare else d, inputs)
     sim = HybridSimulator(dae, p, rtol, atol, max_step, max_steps, obs_idx,
-                          selection=selection)
+                          selection=selection, solver_options=solver_options)
     times, rows, failure = sim.run(grid, progress)
     dae = sim.dae
     names = [dae.names[k] for k in obs_idx]
