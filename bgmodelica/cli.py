@@ -88,7 +88,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     _check_simulate_args(args)
     params = _parse_sets(args.set)
     model = load_model(args.model, **_model_kwargs(args.arg))
-    compiled = compile(model, units=args.units)
+    compiled = compile(model, units=args.units, cache=args.cache)
     out = Path(args.output) if args.output else Path(f"{compiled.name}.csv")
     if not args.output:
         check_output_file(out, "-o (default)")
@@ -132,7 +132,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     from .validate import check_values
 
     model = load_model(args.model, **_model_kwargs(args.arg))
-    compiled = compile(model, units=args.units)
+    compiled = compile(model, units=args.units, cache=args.cache)
     check_values(compiled.dae, compiled.dae.p_default, compiled.reduced.model)
     summary = compiled.summary()
     extra = _bondgraph_report(model)
@@ -198,7 +198,8 @@ def cmd_export(args: argparse.Namespace) -> int:
     from .validate import check_export_args
 
     check_export_args(args)
-    compiled = compile(load_model(args.model, **_model_kwargs(args.arg)), units=args.units)
+    compiled = compile(load_model(args.model, **_model_kwargs(args.arg)), units=args.units,
+                       cache=args.cache)
     path = export_model(compiled, args.output, fmi_version=args.fmi, fmu_type=args.type,
                         stop_time=args.stop_time, step_size=args.step,
                         static_states=args.static_states)
@@ -317,6 +318,10 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--units", choices=("error", "warn", "off"), default="error",
                        help="dimensional analysis of the equations: a mismatch is an error "
                             "(default), a warning, or not checked")
+        p.add_argument("--cache", action="store_true",
+                       help="keep the compiled model on disk and reuse it when the same model "
+                            "is compiled again (folder: $BGMODELICA_CACHE or "
+                            "~/.cache/bgmodelica)")
 
     drw = sub.add_parser("draw", help="draw a bond graph with causal strokes (SVG/PNG)")
     model_args(drw)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import time as _time
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 from .backends.casadi_dae import CasadiDAE, attach_initial_equations, build_dae
@@ -124,17 +125,52 @@ class CompiledModel:
 
 
 def compile(model: Component, *, select: Selector | None = None,  # noqa: A001
-            units: str = "error") -> CompiledModel:
+            units: str = "error", cache: bool | str | Path = False) -> CompiledModel:
     """Compile a component tree into a :class:`CompiledModel`.
 
     units: dimensional analysis of every equation (:mod:`bgmodelica.passes.units`):
     ``"error"`` raises :class:`~bgmodelica.errors.UnitError` at a mismatch, ``"warn"`` warns,
     ``"off"`` skips it.
 
+    cache: keep the compiled model on disk and load it the next time the same model (same
+    structure and code; parameter values may differ) is compiled: True uses
+    :func:`bgmodelica.cache.default_dir`, a path another folder (see :mod:`bgmodelica.cache`).
+    ``timings`` then holds ``cache_load`` (a hit) or the stages and ``cache_store``.
+
     The cyclic garbage collector is paused meanwhile: compilation allocates millions of
     objects that live until the end, and rescanning them costs more than it frees."""
+    if cache is False or cache is None or select is not None:
+        with gc_paused():
+            return _compile(model, select, units)
+    return _compile_cached(model, units, cache)
+
+
+def _compile_cached(model: Component, units: str, cache: bool | str | Path) -> CompiledModel:
+    from . import cache as disk
+
+    if not isinstance(model, Component):
+        raise DeclarationError(
+            f"compile() expects a Component instance, got {type(model).__name__}")
+    folder = disk.default_dir() if cache is True else Path(cache)
+    t0 = _time.perf_counter()
+    try:
+        key = disk.model_key(model) + f"-{units}"
+    except disk.Uncacheable:
+        key = None
+    if key is not None:
+        with gc_paused():
+            hit = disk.load(folder, key, model)
+        if hit is not None:
+            hit.timings = {"cache_load": _time.perf_counter() - t0}
+            return hit
     with gc_paused():
-        return _compile(model, select, units)
+        compiled = _compile(model, None, units)
+    if key is not None:
+        t1 = _time.perf_counter()
+        with gc_paused():
+            disk.store(compiled, folder, key)
+        compiled.timings["cache_store"] = _time.perf_counter() - t1
+    return compiled
 
 
 def _compile(model: Component, select: Selector | None, units: str = "error") -> CompiledModel:

@@ -1,0 +1,355 @@
+"""Disk cache of compiled models: the second compilation of the same model is a load.
+
+The key is a digest of the model's *structure and code*: the component tree (paths, classes,
+declarations with their units, shapes and start values, connections, imperative equations,
+plain instance attributes such as a section count) and the source of every Python module the
+classes come from, plus the compiler's own source. Parameter *values* are not part of it: a
+loaded model takes the values of the component it is asked for, so a parameter study reuses
+one entry. A model with anything the key cannot describe (an attribute of unknown type,
+CasADi expressions written directly in an imperative equation) is compiled without the cache.
+
+Entries are a pickle of the :class:`~bgmodelica.compiler.CompiledModel` whose CasADi
+expressions are stored together in one CasADi serialization (so the expressions keep sharing
+their symbols). ``compile(model, cache=True)`` uses :func:`default_dir` (``$BGMODELICA_CACHE``
+or ``~/.cache/bgmodelica``); ``cache="path"`` another folder; :func:`clear` empties it.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import io
+import os
+import pickle
+import sys
+from dataclasses import fields, is_dataclass, replace
+from pathlib import Path
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from .core.component import Component, Connection, Connector, Element
+from .core.expr import Equation, Expr, Leaf, Op
+from .core.variables import KIND_PARAMETER
+
+FORMAT = 1
+_FILE_DIGESTS: dict[tuple[str, int, int], str] = {}
+
+
+class Uncacheable(Exception):
+    """The model holds something the cache key cannot describe."""
+
+
+def default_dir() -> Path:
+    """``$BGMODELICA_CACHE`` or ``~/.cache/bgmodelica`` (``$XDG_CACHE_HOME`` respected)."""
+    env = os.environ.get("BGMODELICA_CACHE")
+    if env:
+        return Path(env)
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "bgmodelica"
+
+
+def clear(folder: str | Path | None = None) -> int:
+    """Delete every cached model in ``folder`` (default :func:`default_dir`); returns the
+    number of entries removed."""
+    root = Path(folder) if folder is not None else default_dir()
+    n = 0
+    for entry in root.glob("*/*.bgmc"):
+        entry.unlink()
+        n += 1
+    return n
+
+
+# -- the key --------------------------------------------------------------------------------
+
+def _file_digest(path: str) -> str:
+    """SHA-256 of a file's content (memoized while its size and mtime stay the same)."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return "missing"
+    memo = (path, st.st_mtime_ns, st.st_size)
+    if memo not in _FILE_DIGESTS:
+        _FILE_DIGESTS[memo] = hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    return _FILE_DIGESTS[memo]
+
+
+@functools.lru_cache(maxsize=256)
+def _package_files(module_name: str) -> tuple[str, ...]:
+    """The source files of the top-level package of ``module_name`` (or its one file)."""
+    if "." in module_name:
+        return _package_files(module_name.partition(".")[0])
+    top = sys.modules.get(module_name)
+    mod = sys.modules.get(module_name)
+    if top is not None and getattr(top, "__path__", None):
+        root = Path(list(top.__path__)[0])
+        return tuple(sorted(str(p) for p in root.rglob("*.py")))
+    src = getattr(mod, "__file__", None)
+    return (src,) if src else ()
+
+
+def _code_digest(classes: set[type]) -> str:
+    """Digest of the source of the packages that define ``classes``, and of bgmodelica."""
+    files = set(_package_files(__name__))
+    for cls in classes:
+        for base in cls.__mro__:
+            if base.__module__ not in ("builtins", "__main__"):
+                files.update(_package_files(base.__module__))
+            elif base.__module__ == "__main__":
+                main = getattr(sys.modules.get("__main__"), "__file__", None)
+                if not main:
+                    raise Uncacheable(f"{cls.__name__} is defined interactively")
+                files.add(main)
+    h = hashlib.sha256()
+    for path in sorted(files):
+        h.update(f"{path}:{_file_digest(path)}\n".encode())
+    return h.hexdigest()
+
+
+def _value_key(value: Any, where: str) -> str:
+    """Text of a plain attribute value; :class:`Uncacheable` for anything else."""
+    if value is None or isinstance(value, (bool, int, float, str, complex)):
+        text = repr(value)
+        if isinstance(value, str) and len(value) < 4096 and os.path.isfile(value):
+            st = os.stat(value)                         # a data file: its content counts
+            text += f"@{_file_digest(os.path.abspath(value))}:{st.st_size}"
+        return text
+    if isinstance(value, (np.integer, np.floating, np.bool_)):
+        return repr(value.item())
+    if isinstance(value, np.ndarray) and value.dtype.kind in "biuf":
+        return f"array{value.shape}:{hashlib.sha256(value.tobytes()).hexdigest()}"
+    if isinstance(value, (list, tuple)):
+        return "[" + ",".join(_value_key(v, where) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{" + ",".join(f"{_value_key(k, where)}:{_value_key(v, where)}"
+                              for k, v in sorted(value.items(), key=lambda kv: repr(kv[0])))
+    if isinstance(value, Path):
+        return _value_key(str(value), where)
+    raise Uncacheable(f"{where}: attribute of type {type(value).__name__}")
+
+
+@functools.lru_cache(maxsize=64)
+def _key_fields(cls: type) -> tuple[str, ...]:
+    return tuple(f.name for f in fields(cls) if f.name != "description")
+
+
+def _decl_key(decl: Any, where: str) -> str:
+    """Every field of a declaration, the value of a numeric parameter left out."""
+    parameter = decl.kind == KIND_PARAMETER
+    vals: list[Any] = [type(decl).__name__]
+    for name in _key_fields(type(decl)):
+        v = getattr(decl, name)
+        if isinstance(v, Expr):
+            v = _expr_key(v)
+        elif name == "value" and parameter:
+            continue
+        elif isinstance(v, (ca.SX, ca.MX)):
+            raise Uncacheable(f"{where}: a CasADi expression in a declaration")
+        elif isinstance(v, np.ndarray):
+            v = _value_key(v, where)
+        vals.append(v)
+    return repr(vals)
+
+
+_NAMES: dict[int, str] = {}
+
+
+def _expr_or_value(v: Any, where: str) -> str:
+    if isinstance(v, Expr):
+        return _expr_key(v)
+    if isinstance(v, (ca.SX, ca.MX)):
+        raise Uncacheable(f"{where}: a CasADi expression")
+    return _value_key(v, where)
+
+
+def _expr_key(e: Any) -> str:
+    if isinstance(e, float):
+        return repr(e)
+    if isinstance(e, Leaf):
+        sym = e.sym
+        name = _NAMES.get(id(sym))
+        if name is None:
+            name = getattr(sym, "name", "?")
+            if name != "time":
+                raise Uncacheable(f"an expression uses {name}, which is not part of the model")
+        return name
+    if isinstance(e, Op):
+        return f"{e.op}(" + ",".join(_expr_key(a) for a in e.args) + ")"
+    raise Uncacheable(f"an expression node {type(e).__name__}")
+
+
+def model_key(model: Component) -> str:
+    """The cache key of ``model``: a hex digest of its structure and code (see the module
+    docstring); raises :class:`Uncacheable` for models the key cannot describe."""
+    lines: list[str] = []
+    classes: set[type] = set()
+    paths: dict[int, str] = {}
+    order: list[tuple[Element, str]] = []
+    decl_memo: dict[int, str] = {}
+    stack: list[tuple[Element, str]] = [(model, "")]
+    _NAMES.clear()
+    while stack:                           # pass 1: paths of every element and symbol
+        elem, path = stack.pop()
+        paths[id(elem)] = path
+        order.append((elem, path))
+        for name, sym in elem._symbols.items():
+            _NAMES[id(sym)] = f"{path}.{name}" if path else name
+            der = sym.der
+            while der is not None:
+                _NAMES[id(der)] = f"der({_NAMES[id(sym)]})"
+                der = der.der
+        for child_name, child in reversed(list(elem._children.items())):
+            stack.append((child, f"{path}.{child_name}" if path else child_name))
+    try:
+        for elem, path in order:                   # pass 2: what each element holds
+            cls = type(elem)
+            classes.add(cls)
+            lines.append(f"E {path} {cls.__module__}.{cls.__qualname__}")
+            for name, sym in elem._symbols.items():
+                text = decl_memo.get(id(sym.decl))
+                if text is None:
+                    text = decl_memo[id(sym.decl)] = _decl_key(sym.decl, path or "top")
+                lines.append(f"D {name} {text}")
+            for key, value in sorted(vars(elem).items()):
+                if key.startswith("_") or isinstance(value, (Element, Expr)) \
+                        or key in elem._children:
+                    continue
+                from .core.arrays import ArrayExpr, ElementArray
+                if isinstance(value, (ArrayExpr, ElementArray)):
+                    continue
+                lines.append(f"A {key}={_value_key(value, f'{path or cls.__name__}.{key}')}")
+            for item in getattr(elem, "_equations", ()):
+                lines.append("Q " + _item_key(item, paths))
+            for item in elem.__dict__.get("_initial_equations", ()):
+                lines.append("I " + _item_key(item, paths))
+    finally:
+        _NAMES.clear()
+    h = hashlib.sha256()
+    h.update(f"format {FORMAT}\ncode {_code_digest(classes)}\n".encode())
+    h.update("\n".join(lines).encode())
+    return h.hexdigest()
+
+
+def _item_key(item: Any, paths: dict[int, str]) -> str:
+    if isinstance(item, Connection):
+        return "connect(" + ",".join(_end_key(x, paths) for x in (item.a, item.b)) + ")"
+    if isinstance(item, Equation):
+        return f"{_expr_or_value(item.lhs, 'equation')}=={_expr_or_value(item.rhs, 'equation')}"
+    raise Uncacheable(f"an imperative equation of type {type(item).__name__}")
+
+
+def _end_key(x: Any, paths: dict[int, str]) -> str:
+    if isinstance(x, Connector) and id(x) in paths:
+        return paths[id(x)]
+    if isinstance(x, Expr):
+        return _expr_key(x)
+    raise Uncacheable(f"connect() of {x!r}")
+
+
+# -- storing and loading --------------------------------------------------------------------
+
+class _Pickler(pickle.Pickler):
+    """Pickles a compiled model with its SX expressions set aside (stored together)."""
+
+    def __init__(self, f: Any) -> None:
+        super().__init__(f, protocol=pickle.HIGHEST_PROTOCOL)
+        self.sx: list[ca.SX] = []
+        self.ids: dict[int, int] = {}
+
+    def persistent_id(self, obj: Any) -> Any:
+        if isinstance(obj, ca.SX):
+            k = id(obj)
+            if k not in self.ids:
+                self.ids[k] = len(self.sx)
+                self.sx.append(obj)
+            return ("sx", self.ids[k])
+        if isinstance(obj, (Element, ca.Function, ca.MX)):
+            raise Uncacheable(f"the compiled model refers to a {type(obj).__name__}")
+        return None
+
+
+class _Unpickler(pickle.Unpickler):
+    def __init__(self, f: Any, sx: list[ca.SX]) -> None:
+        super().__init__(f)
+        self.sx = sx
+
+    def persistent_load(self, pid: Any) -> Any:
+        return self.sx[pid[1]]
+
+
+def _entry(folder: Path, key: str) -> Path:
+    return folder / key[:2] / f"{key}.bgmc"
+
+
+def store(compiled: Any, folder: Path, key: str) -> Path | None:
+    """Write ``compiled`` under ``key``; None (and nothing written) if it cannot be."""
+    source, cache = compiled.source, compiled.dae.cache
+    compiled.source, compiled.dae.cache = None, {}
+    try:
+        buf = io.BytesIO()
+        p = _Pickler(buf)
+        p.dump(compiled)
+        ser = ca.StringSerializer()
+        ser.pack(p.sx)
+        blob = pickle.dumps((FORMAT, ser.encode(), buf.getvalue()),
+                            protocol=pickle.HIGHEST_PROTOCOL)
+    except (Uncacheable, pickle.PicklingError, TypeError, RuntimeError):
+        return None
+    finally:
+        compiled.source, compiled.dae.cache = source, cache
+    path = _entry(folder, key)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(f".tmp{os.getpid()}")
+    tmp.write_bytes(blob)
+    os.replace(tmp, path)                       # atomic: readers never see half a file
+    return path
+
+
+def load(folder: Path, key: str, model: Component) -> Any | None:
+    """The compiled model stored under ``key`` with ``model``'s parameter values, or None
+    (no entry, or an unreadable one, which is removed)."""
+    path = _entry(folder, key)
+    if not path.is_file():
+        return None
+    try:
+        fmt, text, body = pickle.loads(path.read_bytes())
+        if fmt != FORMAT:
+            raise ValueError("format")
+        sx = ca.StringDeserializer(text).unpack()
+        compiled = _Unpickler(io.BytesIO(body), sx).load()
+    except Exception:  # noqa: BLE001 -- a damaged entry is recompiled, not an error
+        path.unlink(missing_ok=True)
+        return None
+    values = _parameter_values(model)
+    if not all(isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool)
+               for v in values.values()):
+        return None                      # compiling names the bad value
+    compiled.source = model
+    _set_parameter_values(compiled, values)
+    return compiled
+
+
+def _parameter_values(model: Component) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    stack: list[tuple[Element, str]] = [(model, "")]
+    while stack:
+        elem, path = stack.pop()
+        for name, sym in elem._symbols.items():
+            if sym.decl.kind == KIND_PARAMETER and not isinstance(sym.decl.value, Expr):
+                out[f"{path}.{name}" if path else name] = sym.decl.value
+        stack.extend((c, f"{path}.{n}" if path else n) for n, c in elem._children.items())
+    return out
+
+
+def _set_parameter_values(compiled: Any, values: dict[str, Any]) -> None:
+    seen: set[int] = set()
+    for group in (compiled.flat.parameters, compiled.reduced.model.parameters,
+                  compiled.sorted.model.parameters, compiled.dae.parameters):
+        for p in group:
+            if id(p) in seen or p.name not in values or isinstance(p.decl.value, ca.SX) \
+                    or p.decl.value == values[p.name]:
+                continue
+            seen.add(id(p))
+            if is_dataclass(p.decl):
+                p.decl = replace(p.decl, value=values[p.name])

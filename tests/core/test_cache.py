@@ -1,0 +1,105 @@
+"""Disk cache of compiled models: hits, misses on structure or code changes, parameter
+values taken from the model asked for, damaged entries, the command line."""
+
+from __future__ import annotations
+
+import importlib
+import os
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+import bgmodelica as bg
+from bgmodelica import cache as disk
+from library.examples import RC, RCLadderVector
+
+
+def entries(folder):
+    return sorted(folder.glob("*/*.bgmc"))
+
+
+def test_second_compile_is_a_load_with_identical_results(tmp_path):
+    first = bg.compile(RCLadderVector(30), cache=tmp_path)
+    assert "cache_store" in first.timings and len(entries(tmp_path)) == 1
+    second = bg.compile(RCLadderVector(30), cache=tmp_path)
+    assert set(second.timings) == {"cache_load"}
+    a = bg.simulate(first, stop_time=0.5, interval=0.05)
+    b = bg.simulate(second, stop_time=0.5, interval=0.05)
+    assert all(np.array_equal(a[n], b[n]) for n in a.names)
+    assert second.summary()["states"] == first.summary()["states"]
+
+
+def test_parameter_values_come_from_the_model_not_the_entry(tmp_path):
+    bg.compile(RC(), cache=tmp_path)
+    hit = bg.compile(RC(**{"resistor.R": 500.0}), cache=tmp_path)    # tau = 0.5 s
+    assert set(hit.timings) == {"cache_load"}
+    res = bg.simulate(hit, stop_time=2.0, interval=0.1, rtol=1e-10, atol=1e-12)
+    assert np.max(np.abs(res["capacitor.v"] - 10 * (1 - np.exp(-res.time / 0.5)))) < 1e-7
+    assert res.parameters["resistor.R"] == 500.0
+
+
+def test_structure_start_values_and_units_mode_are_part_of_the_key(tmp_path):
+    keys = {disk.model_key(RCLadderVector(5)), disk.model_key(RCLadderVector(6)),
+            disk.model_key(RCLadderVector(5, v=[0.0] * 5)), disk.model_key(RC())}
+    assert len(keys) == 4
+    assert disk.model_key(RCLadderVector(5, R=[2.0] * 5)) == disk.model_key(RCLadderVector(5))
+    bg.compile(RC(), cache=tmp_path)
+    assert "cache_store" in bg.compile(RC(), cache=tmp_path, units="off").timings
+
+
+def test_a_code_change_misses(tmp_path, monkeypatch):
+    pkg = tmp_path / "cachedmodels_pkg"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    src = textwrap.dedent("""
+        from bgmodelica import Component, Parameter, Variable, der
+
+        class Decay(Component):
+            x = Variable(start=1.0, fixed=True)
+            a = Parameter(1.0, unit="1/s")
+
+            def equations(self):
+                yield der(self.x) == -{k} * self.a * self.x
+        """)
+    (pkg / "model.py").write_text(src.format(k=1.0))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    mod = importlib.import_module("cachedmodels_pkg.model")
+    store = tmp_path / "store"
+    bg.compile(mod.Decay(), cache=store)
+    (pkg / "model.py").write_text(src.format(k=2.0) + "\n# changed\n")
+    mod = importlib.reload(mod)
+    again = bg.compile(mod.Decay(), cache=store)
+    assert "cache_store" in again.timings                       # a miss: recompiled
+    res = bg.simulate(again, stop_time=1.0, interval=0.5, rtol=1e-10, atol=1e-12)
+    assert res["x"][-1] == pytest.approx(np.exp(-2.0), rel=1e-8)
+
+
+def test_uncacheable_model_compiles_without_an_entry(tmp_path):
+    m = RC()
+    m.helper = object()                       # nothing the key can describe
+    with pytest.raises(disk.Uncacheable, match="helper"):
+        disk.model_key(m)
+    compiled = bg.compile(m, cache=tmp_path)
+    assert "cache_store" not in compiled.timings and not entries(tmp_path)
+
+
+def test_damaged_entry_is_recompiled_and_replaced(tmp_path):
+    bg.compile(RC(), cache=tmp_path)
+    (entry,) = entries(tmp_path)
+    entry.write_bytes(b"not a pickle")
+    again = bg.compile(RC(), cache=tmp_path)
+    assert "cache_store" in again.timings
+    assert set(bg.compile(RC(), cache=tmp_path).timings) == {"cache_load"}
+    assert disk.clear(tmp_path) == 1 and not entries(tmp_path)
+
+
+def test_cli_cache_flag(tmp_path):
+    env_cmd = [sys.executable, "-m", "bgmodelica.cli", "check", "library.examples:RC",
+               "--cache", "--json"]
+    env = dict(os.environ, BGMODELICA_CACHE=str(tmp_path))
+    for _ in range(2):
+        out = subprocess.run(env_cmd, capture_output=True, text=True, check=True, env=env)
+    assert '"cache_load"' in out.stdout and len(entries(tmp_path)) == 1
