@@ -3,10 +3,12 @@ measured in the same run; optionally rewrite the README's performance table from
 
     python benchmarks/run_all.py [--full] [--json perf.json] [--readme]
 
-Quick mode (default, a few minutes): RC ladder n = 100, 1000; compile scaling of the ladder
-at about 1.4e3 and 1.4e4 equations; the robot; the co-simulation master against
-``fmucontainer``. ``--full`` adds the ladder at n = 10,000 and 100,000 and compile scaling at
-1.4e5 equations (the issue's acceptance sizes; much longer).
+Quick mode (default, a few minutes): RC ladder n = 100, 1000 (a component per section) and
+n = 1000, 10,000 (array equations); the disk cache's second compile; JIT; the robot's CS FMU
+under fmpy against native; compile scaling of the ladder at about 1.4e3 and 1.4e4 equations;
+the robot; the co-simulation master against ``fmucontainer``. ``--full`` adds the ladder at
+n = 10,000 and 100,000 in both forms and compile scaling at 1.4e5 equations (the acceptance
+sizes; much longer).
 
 Baselines: the RC ladder written by hand as a CasADi SX ODE and integrated with CVODES (the
 "floor"), and scipy's BDF with a sparse Jacobian (quick sizes); the robot's hand-written
@@ -98,6 +100,94 @@ def rc_ladder_rows(sizes: list[int], scipy_up_to: int) -> list[dict]:
     return rows
 
 
+def vector_ladder_rows(sizes: list[int], hand: dict[int, float]) -> list[dict]:
+    """The ladder written with array equations (``RCLadderVector``): construct + compile +
+    10-s solve against the hand-written floor of the same size (measured here if not yet)."""
+    from bgmodelica import compile, simulate
+    from library.examples import RCLadderVector
+
+    rows = []
+    for n in sizes:
+        t0 = time.perf_counter()
+        model = RCLadderVector(n)
+        t1 = time.perf_counter()
+        compiled = compile(model)
+        t2 = time.perf_counter()
+        simulate(compiled, stop_time=STOP, interval=DT, rtol=RTOL, atol=ATOL,
+                 outputs=[f"v[{n}]", "v[1]"])
+        t3 = time.perf_counter()
+        floor = hand.get(n) or ladder_by_hand(n)["total"]
+        rows.append({"n": n, "construct": t1 - t0, "compile": t2 - t1, "solve": t3 - t2,
+                     "total": t3 - t0, "casadi_cvodes_total": floor,
+                     "ratio_vs_casadi": (t3 - t0) / floor})
+        print(f"  RC ladder (array equations) n={n}: {t3 - t0:.3f} s (construct "
+              f"{t1 - t0:.3f}, compile {t2 - t1:.3f}, solve {t3 - t2:.3f}), ratio "
+              f"{rows[-1]['ratio_vs_casadi']:.2f}", flush=True)
+    return rows
+
+
+def cache_rows(cases: list[tuple[str, int]]) -> list[dict]:
+    """Compile, then compile again from the disk cache (a fresh temporary folder)."""
+    from rc_ladder import rc_ladder
+
+    from bgmodelica import compile
+    from library.examples import RCLadderVector
+
+    make = {"component per section": rc_ladder, "array equations": RCLadderVector}
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="bgm_cache_") as folder:
+        for form, n in cases:
+            first = compile(make[form](n), cache=folder)
+            t0 = time.perf_counter()
+            again = compile(make[form](n), cache=folder)
+            load = time.perf_counter() - t0
+            build = sum(v for k, v in first.timings.items() if k != "cache_store")
+            rows.append({"form": form, "n": n, "compile": build, "cached_compile": load,
+                         "hit": "cache_load" in again.timings})
+            print(f"  cache, {form} n={n}: compile {build:.3f} s, second compile "
+                  f"{load:.3f} s", flush=True)
+    return rows
+
+
+def jit_rows(repeat: int) -> dict:
+    from jit_crossover import main as jit_main
+
+    from bgmodelica.solver_options import compiler
+
+    if compiler() is None:
+        return {}
+    return jit_main([100], repeat)
+
+
+def fmu_cs_vs_native(repeat: int) -> dict:
+    """The robot exported as a Co-Simulation FMU and run by fmpy (10 s, 10 ms communication
+    step) against ``simulate`` of the same compiled model."""
+    from fmpy import simulate_fmu
+
+    from bgmodelica import compile, simulate
+    from bgmodelica.fmi.from_model import export_model
+    from library.robots.robot import RobotPID
+
+    def best(fn) -> float:
+        b = math.inf
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            fn()
+            b = min(b, time.perf_counter() - t0)
+        return b
+
+    compiled = compile(RobotPID())
+    with tempfile.TemporaryDirectory(prefix="bgm_fmu_cs_") as tmp:
+        fmu = export_model(compiled, tmp, fmi_version=2, fmu_type="cs", stop_time=STOP)
+        t_fmu = best(lambda: simulate_fmu(str(fmu), stop_time=STOP, output_interval=DT,
+                                          output=["arm.q1", "arm.q2"]))
+    t_native = best(lambda: simulate(compiled, stop_time=STOP, interval=DT, rtol=1e-6,
+                                     atol=1e-8))
+    print(f"  robot CS FMU under fmpy {t_fmu:.4f} s, native simulate {t_native:.4f} s",
+          flush=True)
+    return {"fmu_cs_fmpy": t_fmu, "native": t_native, "ratio": t_fmu / t_native}
+
+
 def compile_rows(sizes: list[int]) -> dict:
     from compile_scaling import measure
     from rc_ladder import rc_ladder
@@ -183,6 +273,25 @@ def table(report: dict) -> str:
                  f"{rb['casadi'] * 1e3:.1f} ms | "
                  f"{rb['ratio_auto_vs_casadi']:.2f}x | |")
     lines.append(f"| robot compile | {rb['build'] * 1e3:.0f} ms | | | < 300 ms |")
+    for r in report.get("rc_ladder_vector", []):
+        lines.append(f"| RC ladder, array equations, n = {r['n']:,}, build + 10-s solve | "
+                     f"{r['total']:.3f} s (compile {r['compile']:.3f} s) | CasADi/CVODES by "
+                     f"hand {r['casadi_cvodes_total']:.3f} s | {r['ratio_vs_casadi']:.2f}x | "
+                     f"{'compile < 1 s' if r['n'] == 100000 else ''} |")
+    for r in report.get("cache", []):
+        lines.append(f"| second compile from the disk cache, RC ladder ({r['form']}), "
+                     f"n = {r['n']:,} | {r['cached_compile']:.3f} s | first compile "
+                     f"{r['compile']:.3f} s | {r['compile'] / r['cached_compile']:.1f}x faster |"
+                     " |")
+    for name, r in report.get("jit", {}).items():
+        lines.append(f"| `simulate(jit=True)`, {name}, per 10-s run | {r['run_jit'] * 1e3:.1f} ms"
+                     f" | without JIT {r['run_plain'] * 1e3:.1f} ms | {r['speedup']:.2f}x faster"
+                     f"; pays off after {r['crossover_runs']} runs | |")
+    fc = report.get("fmu_cs")
+    if fc:
+        lines.append(f"| robot CS FMU under fmpy, 10 s | {fc['fmu_cs_fmpy'] * 1e3:.1f} ms | "
+                     f"native `simulate` {fc['native'] * 1e3:.1f} ms | {fc['ratio']:.2f}x | "
+                     "<= 1.5x |")
     mc = report.get("cosim")
     if mc and mc.get("fmucontainer_s_per_s"):
         lines.append(f"| co-simulation master, robot split, 1 ms (Jacobi) | "
@@ -217,6 +326,16 @@ def main() -> int:
                     "machine": {"python": platform.python_version(),
                                 "processor": platform.machine()},
                     "rc_ladder": rc_ladder_rows(sizes, scipy_up_to=1000)}
+    hand = {r["n"]: r["casadi_cvodes_total"] for r in report["rc_ladder"]}
+    vec_sizes = [100, 1000, 10000, 100000] if args.full else [1000, 10000]
+    report["rc_ladder_vector"] = vector_ladder_rows(vec_sizes, hand)
+    print("disk cache", flush=True)
+    report["cache"] = cache_rows([("component per section", 1000), ("array equations", 10000)]
+                                 + ([("component per section", 10000)] if args.full else []))
+    print("JIT", flush=True)
+    report["jit"] = jit_rows(args.repeat)
+    print("robot CS FMU", flush=True)
+    report["fmu_cs"] = fmu_cs_vs_native(args.repeat)
     print("compile scaling", flush=True)
     report["compile"] = compile_rows(cells)
     print("robot", flush=True)

@@ -17,6 +17,7 @@ from .core.units import with_units
 from .diagnose import check_initial_point, check_result, unsafe_outputs
 from .errors import ParameterError, SimulationError
 from .events.fast import Fast
+from .integration import _integrate, _integrator, _xdot  # noqa: F401 (used by studies)
 from .result import Result
 from .solver_options import integrator_settings
 from .validate import check_run_options, check_values, output_grid
@@ -195,10 +196,19 @@ def _finite_run(dae: CasadiDAE, obs_idx: list[int], times: np.ndarray, xs: np.nd
     stay lazy (computed when first read)."""
     if not (np.all(np.isfinite(xs)) and np.all(np.isfinite(zs))):
         return False
-    if "unsafe_observed" not in dae.cache:
+    if "unsafe_observed" in dae.cache:
+        unsafe = [k for k in obs_idx if k in dae.cache["unsafe_observed"]]
+    elif 4 * len(obs_idx) < len(dae.names):     # a few outputs: analyse only those
+        key = ("unsafe_of", tuple(obs_idx))
+        if key not in dae.cache:
+            f = ca.Function("observed", [dae.t, dae.x, dae.z, dae.p],
+                            [ca.densify(dae.observed[obs_idx])])
+            dae.cache[key] = [obs_idx[k] for k in unsafe_outputs(f, (0, 1, 2))]
+        unsafe = dae.cache[key]
+    else:
         f = ca.Function("observed", [dae.t, dae.x, dae.z, dae.p], [ca.densify(dae.observed)])
         dae.cache["unsafe_observed"] = set(unsafe_outputs(f, (0, 1, 2)))
-    unsafe = [k for k in obs_idx if k in dae.cache["unsafe_observed"]]
+        unsafe = [k for k in obs_idx if k in dae.cache["unsafe_observed"]]
     if not unsafe or not len(times):
         return True
     with np.errstate(all="ignore"):
@@ -417,82 +427,6 @@ def _make_observer(dae: CasadiDAE, idx: list[int]) -> Callable:
         return out.reshape(n, len(idx)).copy()
 
     return run
-
-
-def _integrator(dae: CasadiDAE, solver: str, t0: float, tout: np.ndarray, opts: dict):
-    x, ode = dae.x, dae.ode
-    if x.numel() == 0:                      # purely algebraic model: integrate a dummy state
-        x, ode = ca.SX.sym("_dummy"), ca.SX(0)
-    problem = {"x": x, "p": dae.p, "t": dae.t, "ode": ode}
-    if dae.z.numel():
-        if solver != "idas":
-            raise ParameterError(f"solver {solver!r} cannot handle the algebraic variables "
-                                 f"{', '.join(dae.algebraic_names[:5])}; use 'idas'")
-        problem.update(z=dae.z, alg=dae.alg)
-    return ca.integrator("sim", solver, problem, float(t0), list(map(float, tout)), opts)
-
-
-def _cached_integrator(dae: CasadiDAE, solver: str, t0: float, tout: np.ndarray, opts: dict):
-    """The integrator for these settings, reused by repeated runs of the same model."""
-    key = ("integrator", solver, float(t0), tuple(map(float, tout)),
-           tuple(sorted((k, repr(v)) for k, v in opts.items())))
-    cache = dae.cache.setdefault("integrators", {})
-    if key not in cache:
-        if len(cache) >= 4:
-            cache.pop(next(iter(cache)))
-        cache[key] = _integrator(dae, solver, t0, tout, opts)
-    return cache[key]
-
-
-def _xdot(dae: CasadiDAE, t: float, x, z, p) -> list[float]:
-    """Consistent initial state derivative for IDAS (we skip IDACalcIC: x0, z0 are solved)."""
-    if "xdot" not in dae.cache:
-        dae.cache["xdot"] = ca.Function("xdot0", [dae.t, dae.x, dae.z, dae.p], [dae.ode])
-    f = dae.cache["xdot"]
-    return [float(v) for v in np.asarray(f(t, x, z, p)).ravel()]
-
-
-def _integrate(dae: CasadiDAE, solver: str, grid: np.ndarray, x0, z0, p, opts, progress):
-    nx = max(dae.x.numel(), 1)
-    x0 = x0 if dae.x.numel() else np.zeros(1)
-    chunks = [grid] if progress is None else np.array_split(grid, min(20, len(grid) - 1))
-    if progress is not None:          # overlapping chunks: each starts where the last ended
-        chunks = [np.concatenate(([chunks[k - 1][-1]], c)) if k else c
-                  for k, c in enumerate(chunks)]
-    xs, zs = [x0.reshape(nx, 1)], [np.asarray(z0).reshape(-1, 1)]
-    stats: dict[str, Any] = {}
-    failure = None
-    xk, zk = x0, z0
-    for chunk in chunks:
-        if len(chunk) < 2:
-            continue
-        try:
-            chunk_opts = dict(opts)
-            if solver != "idas":
-                chunk_opts.pop("calc_ic", None)      # an IDAS-only option
-            if solver == "idas" and dae.x.numel():
-                chunk_opts["init_xdot"] = _xdot(dae, chunk[0], xk, zk, p)
-            F = _cached_integrator(dae, solver, chunk[0], chunk[1:], chunk_opts)
-            out = F(x0=xk, z0=zk, p=p)
-        except RuntimeError as err:
-            failure = str(err)
-            break
-        xf = np.asarray(out["xf"]).reshape(nx, -1)
-        zf = np.asarray(out["zf"]).reshape(len(z0), -1) if len(z0) else np.zeros((0, xf.shape[1]))
-        xs.append(xf)
-        zs.append(zf)
-        xk, zk = xf[:, -1], zf[:, -1] if len(z0) else z0
-        for key, val in F.stats().items():
-            if isinstance(val, (int, float)) and not isinstance(val, bool):
-                stats[key] = stats.get(key, 0) + val
-        if progress is not None:
-            progress(float((chunk[-1] - grid[0]) / (grid[-1] - grid[0])))
-    if failure is not None and progress is None and len(grid) > 2:
-        return _integrate(dae, solver, grid, x0, z0, p, opts, lambda _f: None)
-    X = np.hstack(xs)[: dae.x.numel()] if dae.x.numel() else np.zeros((0, sum(
-        a.shape[1] for a in xs)))
-    Z = np.hstack(zs)
-    return X, Z, stats, failure
 
 
 def _selection(compiled: CompiledModel, dynamic: bool, start_over: dict[str, Any],

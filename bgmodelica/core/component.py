@@ -415,16 +415,24 @@ class Component(Element):
             if own is not None:
                 result = own(self)
                 if result is not None:
-                    yield from _scalar_items(result)
-        yield from _scalar_items(self._equations)
+                    for item in result:
+                        if isinstance(item, (ArrayEquation, list)):
+                            yield from _scalar_items(item)
+                        else:
+                            yield item
+        for item in self._equations:
+            if isinstance(item, (ArrayEquation, list)):
+                yield from _scalar_items(item)
+            else:
+                yield item
 
 
-def _scalar_items(items: Iterable[Any]) -> Iterator[Any]:
-    """Equations and connections, with array equations and lists of them expanded."""
-    for item in items:
-        if isinstance(item, ArrayEquation):
-            yield from item.equations()
-        elif isinstance(item, list) and item and all(isinstance(c, Connection) for c in item):
-            yield from item
-        else:
-            yield item
+def _scalar_items(item: Any) -> Iterator[Any]:
+    """The scalar equations of an array equation, the connections of a list of them (as
+    ``connect`` over arrays makes); anything else as it is."""
+    if isinstance(item, ArrayEquation):
+        yield from item.equations()
+    elif item and all(isinstance(c, Connection) for c in item):
+        yield from item
+    else:
+        yield item
