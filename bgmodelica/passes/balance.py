@@ -14,7 +14,7 @@ from ..errors import UnbalancedModelError
 from ..structure.diagnosis import dulmage_mendelsohn
 from ..structure.matching import maximum_matching
 from .reference import likely_causes
-from .symbolic import incidence
+from .symbolic import model_incidence
 
 
 @dataclass(frozen=True)
@@ -46,7 +46,7 @@ def check_balance(model: FlatModel, max_listed: int = 12) -> BalanceReport:
     report = BalanceReport(len(model.equations), len(unknowns))
     column = {v: k for k, v in enumerate(unknowns)}
     base = base_of(model)
-    inc = incidence([e.residual for e in model.equations], [v.sx for v in model.variables])
+    inc = model_incidence(model)
     eq_vars = [sorted({column[base[j]] for j in row}) for row in inc]
     for k, row in enumerate(eq_vars):
         if not row:

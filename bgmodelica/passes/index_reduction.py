@@ -17,7 +17,7 @@ from ..core.variables import TIME, Variable, derivative_unit
 from ..errors import EquationError, StateSelectError, UnbalancedModelError
 from ..structure import EquationGraph, dummy_derivatives, pantelides
 from ..structure.errors import StateSelectionError, StructuralError, StructurallySingular
-from .symbolic import incidence, time_derivative
+from .symbolic import incidence, model_incidence, time_derivative
 
 Selector = Callable[[int, list[int], list[int], list[int]], list[int]]
 
@@ -56,7 +56,7 @@ def reduce_index(model: FlatModel | ReducedModel,
         links = list(model.graph.eq_derivative)
         model = model.model
     syms = [v.sx for v in model.variables]
-    eq_vars = incidence([e.residual for e in model.equations], syms)
+    eq_vars = [list(row) for row in model_incidence(model)]
     graph = EquationGraph(eq_vars, len(syms), [v.der for v in model.variables], links)
     try:
         pant = pantelides(graph)

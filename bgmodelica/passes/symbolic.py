@@ -21,6 +21,19 @@ def incidence(residuals: Sequence[ca.SX], symbols: Sequence[ca.SX]) -> list[list
     return rows
 
 
+def model_incidence(model) -> list[list[int]]:
+    """:func:`incidence` of a flat model's equations in its variables, computed once per
+    model (the balance check and index reduction both need it; on large models it costs a
+    Jacobian sparsity pass over every equation). Recomputed if either list changed size."""
+    key = (len(model.equations), len(model.variables))
+    memo = model.__dict__.get("_incidence_memo")
+    if memo is not None and memo[0] == key:
+        return memo[1]
+    rows = incidence([e.residual for e in model.equations], [v.sx for v in model.variables])
+    model.__dict__["_incidence_memo"] = (key, rows)
+    return rows
+
+
 def time_derivative(residual: ca.SX, syms: Sequence[ca.SX], rates: Sequence[ca.SX],
                     time: ca.SX) -> ca.SX:
     """d/dt of ``residual`` given the time derivatives ``rates`` of ``syms``."""
