@@ -22,7 +22,7 @@ import io
 import os
 import pickle
 import sys
-from dataclasses import fields, is_dataclass, replace
+from dataclasses import is_dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -129,27 +129,26 @@ def _value_key(value: Any, where: str) -> str:
     raise Uncacheable(f"{where}: attribute of type {type(value).__name__}")
 
 
-@functools.lru_cache(maxsize=64)
-def _key_fields(cls: type) -> tuple[str, ...]:
-    return tuple(f.name for f in fields(cls) if f.name != "description")
+_PLAIN = (str, float, int, bool, type(None), tuple)
 
 
 def _decl_key(decl: Any, where: str) -> str:
-    """Every field of a declaration, the value of a numeric parameter left out."""
-    parameter = decl.kind == KIND_PARAMETER
-    vals: list[Any] = [type(decl).__name__]
-    for name in _key_fields(type(decl)):
-        v = getattr(decl, name)
-        if isinstance(v, Expr):
-            v = _expr_key(v)
-        elif name == "value" and parameter:
+    """Every field of a declaration but its description, and the value of a numeric
+    parameter left out."""
+    fields_ = dict(vars(decl))
+    fields_.pop("description", None)
+    if decl.kind == KIND_PARAMETER and not isinstance(fields_.get("value"), Expr):
+        fields_.pop("value", None)
+    for name, v in fields_.items():
+        if isinstance(v, _PLAIN):
             continue
+        if isinstance(v, Expr):
+            fields_[name] = _expr_key(v)
         elif isinstance(v, (ca.SX, ca.MX)):
             raise Uncacheable(f"{where}: a CasADi expression in a declaration")
-        elif isinstance(v, np.ndarray):
-            v = _value_key(v, where)
-        vals.append(v)
-    return repr(vals)
+        else:
+            fields_[name] = _value_key(v, where)
+    return f"{type(decl).__name__}{fields_!r}"
 
 
 _NAMES: dict[int, str] = {}

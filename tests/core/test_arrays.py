@@ -140,3 +140,48 @@ def test_check_prints_arrays_compactly():
                          capture_output=True, text=True, check=True).stdout
     assert "states (40): v[1:40]" in out
     assert "100 equations" not in out and "80 equations" in out
+
+
+class Bus(bg.Connector):
+    """Three wires: potentials and currents as arrays."""
+
+    v = bg.Potential(shape=3, unit="V")
+    i = bg.Flow(shape=3, unit="A")
+
+
+class BusRC(Component):
+    """Per wire: a capacitor C from the bus to ground (bus currents flow into it)."""
+
+    p = Bus()
+    C = Parameter(shape=3, value=[1.0, 2.0, 4.0], unit="F")
+
+    def equations(self):
+        yield self.C * der(self.p.v) == self.p.i
+
+
+class BusLoad(Component):
+    """Per wire: a resistor R from the bus to ground."""
+
+    p = Bus()
+    R = Parameter(1.0, unit="Ohm")
+
+    def equations(self):
+        yield self.p.v == self.R * self.p.i
+
+
+class ThreePhaseDecay(Component):
+    """Each capacitor discharges through its resistor: v[k](t) = v0[k] exp(-t/(R C[k]))."""
+
+    caps = BusRC()
+    load = BusLoad()
+
+    def equations(self):
+        yield bg.connect(self.caps.p, self.load.p)
+
+
+def test_connector_with_array_variables_connects_elementwise():
+    m = ThreePhaseDecay(**{"caps.p.v": [1.0, 2.0, 3.0]})       # array start values
+    res = bg.simulate(m, stop_time=2.0, interval=0.5, **TIGHT)
+    for k, (v0, c) in enumerate(zip([1.0, 2.0, 3.0], [1.0, 2.0, 4.0], strict=True)):
+        exact = v0 * np.exp(-res.time / c)
+        assert np.max(np.abs(res[f"caps.p.v[{k + 1}]"] - exact)) < 1e-8
