@@ -37,6 +37,16 @@ MARK_START, MARK_END = "<!-- perf-table:start -->", "<!-- perf-table:end -->"
 STOP, DT, RTOL, ATOL = 10.0, 0.01, 1e-6, 1e-6
 
 
+def best_time(fn, repeat: int) -> float:
+    """Smallest wall time of ``repeat`` calls of ``fn`` [s]."""
+    b = math.inf
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        b = min(b, time.perf_counter() - t0)
+    return b
+
+
 def ladder_by_hand(n: int) -> dict[str, float]:
     """The RC ladder as one CasADi SX vector ODE, CVODES, same grid and tolerances."""
     t0 = time.perf_counter()
@@ -169,21 +179,13 @@ def fmu_cs_vs_native(repeat: int) -> dict:
     from bgmodelica.fmi.from_model import export_model
     from library.robots.robot import RobotPID
 
-    def best(fn) -> float:
-        b = math.inf
-        for _ in range(repeat):
-            t0 = time.perf_counter()
-            fn()
-            b = min(b, time.perf_counter() - t0)
-        return b
-
     compiled = compile(RobotPID())
     with tempfile.TemporaryDirectory(prefix="bgm_fmu_cs_") as tmp:
         fmu = export_model(compiled, tmp, fmi_version=2, fmu_type="cs", stop_time=STOP)
-        t_fmu = best(lambda: simulate_fmu(str(fmu), stop_time=STOP, output_interval=DT,
-                                          output=["arm.q1", "arm.q2"]))
-    t_native = best(lambda: simulate(compiled, stop_time=STOP, interval=DT, rtol=1e-6,
-                                     atol=1e-8))
+        t_fmu = best_time(lambda: simulate_fmu(str(fmu), stop_time=STOP, output_interval=DT,
+                                               output=["arm.q1", "arm.q2"]), repeat)
+    t_native = best_time(lambda: simulate(compiled, stop_time=STOP, interval=DT, rtol=1e-6,
+                                          atol=1e-8), repeat)
     print(f"  robot CS FMU under fmpy {t_fmu:.4f} s, native simulate {t_native:.4f} s",
           flush=True)
     return {"fmu_cs_fmpy": t_fmu, "native": t_native, "ratio": t_fmu / t_native}
@@ -222,22 +224,16 @@ def master_vs_container(stop_time: float, repeat: int) -> dict:
     from bgmodelica.cosim.xcheck import build_container, run_container
     from library.robots.subsystems import build_robot_fmus, robot_system
 
-    def best(fn) -> float:
-        b = math.inf
-        for _ in range(repeat):
-            t0 = time.perf_counter()
-            fn()
-            b = min(b, time.perf_counter() - t0)
-        return b
-
     with tempfile.TemporaryDirectory(prefix="bgm_run_all_") as tmp:
         system = robot_system(dict(build_robot_fmus(Path(tmp) / "fmu")))
         master = Master(system)
-        jac = best(lambda: master.simulate(stop_time, 1e-3)) / stop_time
-        gs = best(lambda: master.simulate(stop_time, 1e-3, order="gauss-seidel")) / stop_time
+        jac = best_time(lambda: master.simulate(stop_time, 1e-3), repeat) / stop_time
+        gs = best_time(lambda: master.simulate(stop_time, 1e-3, order="gauss-seidel"),
+                       repeat) / stop_time
         try:
             container = build_container(system, Path(tmp) / "container", step_size=1e-3)
-            cont = best(lambda: run_container(container, stop_time, 1e-3)) / stop_time
+            cont = best_time(lambda: run_container(container, stop_time, 1e-3),
+                             repeat) / stop_time
         except Exception as err:  # noqa: BLE001 - fmu-manipulation-toolbox is optional
             print(f"  fmucontainer unavailable: {err}")
             cont = None
