@@ -43,11 +43,15 @@ class FlatEquation:
 
     origin: the component path and class that wrote it, or the connection set.
     alias: for equations of the form ``a = s*b`` the variable indices and sign ``(a, b, s)``.
+    terms: number of variables of a long sum (a connection set's flow balance), 0 for an
+    ordinary equation: passes keep long sums out of whole-model sparsity sweeps, whose cost
+    grows with the number of rows times the longest expression.
     """
 
     residual: ca.SX
     origin: str
     alias: tuple[int, int, float] | None = None
+    terms: int = 0
 
     def describe(self, names: dict[int, str] | None = None, width: int = 100) -> str:
         """``0 = residual   [origin]`` with dotted names when ``names`` (hash -> name) given."""

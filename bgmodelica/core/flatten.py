@@ -329,8 +329,8 @@ class _Flattener:
             sel = ca.DM.triplet(rows, cols, ca.DM(vals), len(pairs.sums), self.all_sx.numel())
             totals = ca.mtimes(sel, self.all_sx)
             parts = ca.vertsplit(totals) if len(pairs.sums) > 1 else [totals]
-            for total, (_, _, origin) in zip(parts, pairs.sums, strict=True):
-                self.equations.append(FlatEquation(total, origin))
+            for total, (syms, _, origin) in zip(parts, pairs.sums, strict=True):
+                self.equations.append(FlatEquation(total, origin, terms=len(syms)))
         if not pairs.a:
             return
         ia = [self.pos[id(s)] for s in pairs.a]

@@ -76,7 +76,8 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
                    zip(parts[len(kept):len(kept) + n_init], model.initial_equations, strict=True)]
         if hybrid is not None:
             hybrid = hybrid.with_expressions(parts[len(kept) + n_init:])
-    equations = [FlatEquation(res, eq.origin) for res, eq in zip(residuals, kept, strict=True)]
+    equations = [FlatEquation(res, eq.origin, terms=eq.terms)
+                 for res, eq in zip(residuals, kept, strict=True)]
     keep_idx = [i for i in range(len(new_vars)) if i not in eliminated]
     remap = {old_i: new_i for new_i, old_i in enumerate(keep_idx)}
     final = []

@@ -17,7 +17,7 @@ from ..core.variables import TIME, Variable, derivative_unit
 from ..errors import EquationError, StateSelectError, UnbalancedModelError
 from ..structure import EquationGraph, dummy_derivatives, pantelides
 from ..structure.errors import StateSelectionError, StructuralError, StructurallySingular
-from .symbolic import incidence, model_incidence, time_derivative
+from .symbolic import incidence, long_rows, model_incidence, time_derivative
 
 Selector = Callable[[int, list[int], list[int], list[int]], list[int]]
 
@@ -87,12 +87,13 @@ def reduce_index(model: FlatModel | ReducedModel,
         _check_inputs(model, src)
         res = time_derivative(src.residual, [variables[j].sx for j in vs],
                               [variables[variables[j].der].sx for j in vs], TIME.sx)
-        equations.append(FlatEquation(res, f"d/dt of {src.origin}"))
+        equations.append(FlatEquation(res, f"d/dt of {src.origin}", terms=src.terms))
         rows.append(sorted(set(vs) | {variables[j].der for j in vs}))   # superset for now
     n_old = len(eq_vars)
     if len(equations) > n_old:                 # exact incidence of all new equations at once
         rows[n_old:] = incidence([e.residual for e in equations[n_old:]],
-                                 [v.sx for v in variables])
+                                 [v.sx for v in variables],
+                                 long_rows(equations[n_old:]))
     aug = FlatModel(model.name, variables, model.parameters, model.inputs, equations,
                     model.aliases, model.discretes, model.hybrid)
     eq_derivative = (links + [-1] * (len(equations) - len(links))) if links \

@@ -20,7 +20,7 @@ from ..diagnose import singular_linear_block
 from ..errors import EquationError, UnbalancedModelError
 from ..structure import block_lower_triangular, maximum_matching, tear
 from .index_reduction import ReducedModel
-from .symbolic import solve_linear_block, solve_linear_scalar, solve_scalar_blocks
+from .symbolic import LONG_ROW, solve_linear_block, solve_linear_scalar, solve_scalar_blocks
 
 
 @dataclass
@@ -89,7 +89,9 @@ def sort_equations(reduced: ReducedModel) -> SortedDAE:
     blocks = block_lower_triangular(eq_cols, len(unknowns), matching)
     scalar = [b for b in blocks if len(b.eqs) == 1]
     solved = solve_scalar_blocks([res[b.eqs[0]] for b in scalar],
-                                 [sym[b.vars[0]] for b in scalar])
+                                 [sym[b.vars[0]] for b in scalar],
+                                 {k for k, b in enumerate(scalar)
+                                  if model.equations[b.eqs[0]].terms > LONG_ROW})
     explicit = {id(b): expr for b, expr in zip(scalar, solved, strict=True)}
     var_hashes: set[int] = set()
     for block in blocks:

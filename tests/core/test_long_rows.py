@@ -1,0 +1,40 @@
+"""Long sums (a ground node joined to every section) are kept out of the whole-model
+sparsity pass: same incidence, same compiled model, and the flag survives the passes."""
+
+from __future__ import annotations
+
+import random
+
+import casadi as ca
+
+import bgmodelica as bg
+from bgmodelica.passes.symbolic import LONG_ROW, incidence
+from library.examples import RCLadder
+
+
+def test_incidence_with_long_rows_equals_the_plain_pass():
+    random.seed(3)
+    x = ca.SX.sym("x", 500)
+    xs = ca.vertsplit(x)
+    rows = [xs[i] * ca.sin(xs[(i * 7) % 500]) - xs[(i * 13) % 500] for i in range(400)]
+    rows.insert(17, ca.sum1(x[::2]) + ca.floor(xs[3]))       # one long sum
+    plain = incidence(rows, xs)
+    assert incidence(rows, xs, {17}) == plain
+    assert plain[17][:3] == [0, 2, 3] and len(plain[17]) == 251
+
+
+def test_ground_balance_is_marked_long_and_compiles_as_without_the_split(monkeypatch):
+    n = LONG_ROW + 10
+    compiled = bg.compile(RCLadder(n))
+    long = [e for e in compiled.flat.equations if e.terms > LONG_ROW]   # after aliases
+    assert len(long) == 1 and long[0].terms == n + 2        # C1..Cn, source and ground
+    res = bg.simulate(compiled, stop_time=0.2, interval=0.1)
+    import bgmodelica.passes.sorting as sorting
+    import bgmodelica.passes.symbolic as symbolic
+
+    monkeypatch.setattr(symbolic, "LONG_ROW", 10**9)         # no split anywhere
+    monkeypatch.setattr(sorting, "LONG_ROW", 10**9)
+    plain = bg.compile(RCLadder(n))
+    assert plain.summary()["states"] == compiled.summary()["states"]
+    ref = bg.simulate(plain, stop_time=0.2, interval=0.1)
+    assert all((res[k] == ref[k]).all() for k in ref.names)
