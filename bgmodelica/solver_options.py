@@ -26,8 +26,9 @@ integrator evaluates and compile them with the system C compiler (``cc``) withou
 optimization (``-O0``: the generated code is straight-line, and optimizing it costs far more
 compile time than it saves: ``-O1`` takes 23 s instead of 5 s on the 1000-section ladder
 for a 1.4x faster run); ``jit="O1"`` or ``"O2"`` asks for more. It pays off for long or
-repeated runs; ``benchmarks/jit_crossover.py`` measures the crossover (on this machine:
-the robot gains 1.3-1.7x per run after 0.13 s of compilation, about 10 runs of 10 s).
+repeated runs; ``benchmarks/jit_crossover.py`` measures the crossover (on the shared
+development machine the robot gained 1.25-1.66x per 10-s run in three of four runs, after
+0.1-0.3 s of compilation, i.e. from about 10-30 runs; the fourth, noisy run showed no gain).
 """
 
 from __future__ import annotations
