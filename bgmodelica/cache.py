@@ -132,118 +132,110 @@ def _value_key(value: Any, where: str) -> str:
 _PLAIN = (str, float, int, bool, type(None), tuple)
 
 
-def _decl_key(decl: Any, where: str) -> str:
-    """Every field of a declaration but its description, and the value of a numeric
-    parameter left out."""
-    fields_ = dict(vars(decl))
-    fields_.pop("description", None)
-    if decl.kind == KIND_PARAMETER and not isinstance(fields_.get("value"), Expr):
-        fields_.pop("value", None)
-    for name, v in fields_.items():
-        if isinstance(v, _PLAIN):
-            continue
+class _KeyWriter:
+    """Text of the parts of one model: element paths and dotted symbol names resolved."""
+
+    def __init__(self, paths: dict[int, str], names: dict[int, str]) -> None:
+        self.paths, self.names = paths, names
+
+    def decl(self, decl: Any, where: str) -> str:
+        """Every field of a declaration but its description, and the value of a numeric
+        parameter left out."""
+        fields_ = dict(vars(decl))
+        fields_.pop("description", None)
+        if decl.kind == KIND_PARAMETER and not isinstance(fields_.get("value"), Expr):
+            fields_.pop("value", None)
+        for name, v in fields_.items():
+            if not isinstance(v, _PLAIN):
+                fields_[name] = self.expr_or_value(v, where)
+        return f"{type(decl).__name__}{fields_!r}"
+
+    def expr_or_value(self, v: Any, where: str) -> str:
         if isinstance(v, Expr):
-            fields_[name] = _expr_key(v)
-        elif isinstance(v, (ca.SX, ca.MX)):
-            raise Uncacheable(f"{where}: a CasADi expression in a declaration")
-        else:
-            fields_[name] = _value_key(v, where)
-    return f"{type(decl).__name__}{fields_!r}"
+            return self.expr(v)
+        if isinstance(v, (ca.SX, ca.MX)):
+            raise Uncacheable(f"{where}: a CasADi expression")
+        return _value_key(v, where)
 
+    def expr(self, e: Any) -> str:
+        if isinstance(e, float):
+            return repr(e)
+        if isinstance(e, Leaf):
+            name = self.names.get(id(e.sym))
+            if name is None:
+                name = getattr(e.sym, "name", "?")
+                if name != "time":
+                    raise Uncacheable(f"an expression uses {name}, which is not part of the "
+                                      "model")
+            return name
+        if isinstance(e, Op):
+            return f"{e.op}(" + ",".join(self.expr(a) for a in e.args) + ")"
+        raise Uncacheable(f"an expression node {type(e).__name__}")
 
-_NAMES: dict[int, str] = {}
+    def item(self, item: Any) -> str:
+        """An imperative equation or connection."""
+        if isinstance(item, Connection):
+            return "connect(" + ",".join(self.end(x) for x in (item.a, item.b)) + ")"
+        if isinstance(item, Equation):
+            return (f"{self.expr_or_value(item.lhs, 'equation')}=="
+                    f"{self.expr_or_value(item.rhs, 'equation')}")
+        raise Uncacheable(f"an imperative equation of type {type(item).__name__}")
 
-
-def _expr_or_value(v: Any, where: str) -> str:
-    if isinstance(v, Expr):
-        return _expr_key(v)
-    if isinstance(v, (ca.SX, ca.MX)):
-        raise Uncacheable(f"{where}: a CasADi expression")
-    return _value_key(v, where)
-
-
-def _expr_key(e: Any) -> str:
-    if isinstance(e, float):
-        return repr(e)
-    if isinstance(e, Leaf):
-        sym = e.sym
-        name = _NAMES.get(id(sym))
-        if name is None:
-            name = getattr(sym, "name", "?")
-            if name != "time":
-                raise Uncacheable(f"an expression uses {name}, which is not part of the model")
-        return name
-    if isinstance(e, Op):
-        return f"{e.op}(" + ",".join(_expr_key(a) for a in e.args) + ")"
-    raise Uncacheable(f"an expression node {type(e).__name__}")
+    def end(self, x: Any) -> str:
+        if isinstance(x, Connector) and id(x) in self.paths:
+            return self.paths[id(x)]
+        if isinstance(x, Expr):
+            return self.expr(x)
+        raise Uncacheable(f"connect() of {x!r}")
 
 
 def model_key(model: Component) -> str:
     """The cache key of ``model``: a hex digest of its structure and code (see the module
     docstring); raises :class:`Uncacheable` for models the key cannot describe."""
-    lines: list[str] = []
-    classes: set[type] = set()
+    from .core.arrays import ArrayExpr, ElementArray
+
     paths: dict[int, str] = {}
+    names: dict[int, str] = {}
     order: list[tuple[Element, str]] = []
-    decl_memo: dict[int, str] = {}
     stack: list[tuple[Element, str]] = [(model, "")]
-    _NAMES.clear()
     while stack:                           # pass 1: paths of every element and symbol
         elem, path = stack.pop()
         paths[id(elem)] = path
         order.append((elem, path))
         for name, sym in elem._symbols.items():
-            _NAMES[id(sym)] = f"{path}.{name}" if path else name
+            names[id(sym)] = f"{path}.{name}" if path else name
             der = sym.der
             while der is not None:
-                _NAMES[id(der)] = f"der({_NAMES[id(sym)]})"
+                names[id(der)] = f"der({names[id(sym)]})"
                 der = der.der
         for child_name, child in reversed(list(elem._children.items())):
             stack.append((child, f"{path}.{child_name}" if path else child_name))
-    try:
-        for elem, path in order:                   # pass 2: what each element holds
-            cls = type(elem)
-            classes.add(cls)
-            lines.append(f"E {path} {cls.__module__}.{cls.__qualname__}")
-            for name, sym in elem._symbols.items():
-                text = decl_memo.get(id(sym.decl))
-                if text is None:
-                    text = decl_memo[id(sym.decl)] = _decl_key(sym.decl, path or "top")
-                lines.append(f"D {name} {text}")
-            for key, value in sorted(vars(elem).items()):
-                if key.startswith("_") or isinstance(value, (Element, Expr)) \
-                        or key in elem._children:
-                    continue
-                from .core.arrays import ArrayExpr, ElementArray
-                if isinstance(value, (ArrayExpr, ElementArray)):
-                    continue
-                lines.append(f"A {key}={_value_key(value, f'{path or cls.__name__}.{key}')}")
-            for item in getattr(elem, "_equations", ()):
-                lines.append("Q " + _item_key(item, paths))
-            for item in elem.__dict__.get("_initial_equations", ()):
-                lines.append("I " + _item_key(item, paths))
-    finally:
-        _NAMES.clear()
+    writer = _KeyWriter(paths, names)
+    lines: list[str] = []
+    classes: set[type] = set()
+    decl_memo: dict[int, str] = {}
+    for elem, path in order:                   # pass 2: what each element holds
+        cls = type(elem)
+        classes.add(cls)
+        lines.append(f"E {path} {cls.__module__}.{cls.__qualname__}")
+        for name, sym in elem._symbols.items():
+            text = decl_memo.get(id(sym.decl))
+            if text is None:
+                text = decl_memo[id(sym.decl)] = writer.decl(sym.decl, path or "top")
+            lines.append(f"D {name} {text}")
+        for key, value in sorted(vars(elem).items()):
+            if key.startswith("_") or key in elem._children \
+                    or isinstance(value, (Element, Expr, ArrayExpr, ElementArray)):
+                continue
+            lines.append(f"A {key}={_value_key(value, f'{path or cls.__name__}.{key}')}")
+        for item in getattr(elem, "_equations", ()):
+            lines.append("Q " + writer.item(item))
+        for item in elem.__dict__.get("_initial_equations", ()):
+            lines.append("I " + writer.item(item))
     h = hashlib.sha256()
     h.update(f"format {FORMAT}\ncode {_code_digest(classes)}\n".encode())
     h.update("\n".join(lines).encode())
     return h.hexdigest()
-
-
-def _item_key(item: Any, paths: dict[int, str]) -> str:
-    if isinstance(item, Connection):
-        return "connect(" + ",".join(_end_key(x, paths) for x in (item.a, item.b)) + ")"
-    if isinstance(item, Equation):
-        return f"{_expr_or_value(item.lhs, 'equation')}=={_expr_or_value(item.rhs, 'equation')}"
-    raise Uncacheable(f"an imperative equation of type {type(item).__name__}")
-
-
-def _end_key(x: Any, paths: dict[int, str]) -> str:
-    if isinstance(x, Connector) and id(x) in paths:
-        return paths[id(x)]
-    if isinstance(x, Expr):
-        return _expr_key(x)
-    raise Uncacheable(f"connect() of {x!r}")
 
 
 # -- storing and loading --------------------------------------------------------------------

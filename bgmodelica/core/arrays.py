@@ -243,7 +243,9 @@ class ElementArray:
             raise AttributeError(name)
         parts = [getattr(e, name) for e in self.elements]
         if parts and all(isinstance(p, Expr) for p in parts):
-            return ArrayExpr(np.asarray(parts + [None], dtype=object)[:-1])
+            items = np.empty(len(parts), dtype=object)
+            items[:] = parts
+            return ArrayExpr(items)
         return ElementArray(parts)
 
     def __setattr__(self, name: str, value: Any) -> None:
