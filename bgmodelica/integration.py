@@ -99,11 +99,11 @@ def _run_integrator(F: ca.Function, x0, z0, p, nx: int, nz: int, n_out: int):
         fast.args[F.index_in("z0")][:] = np.asarray(z0, dtype=float).ravel()
     fast.args[F.index_in("p")][:] = np.asarray(p, dtype=float).ravel()
     try:
-        fast._eval()
+        fast()
     except RuntimeError:
         F(x0=x0, z0=z0, p=p)           # raises with the message
         raise
     xf = fast.res[F.index_out("xf")].reshape(n_out, nx).T.copy()
     zf = fast.res[F.index_out("zf")].reshape(n_out, nz).T.copy() if nz \
         else np.zeros((0, n_out))
-    return xf, zf, fast._buf.stats()
+    return xf, zf, fast.stats()

@@ -89,9 +89,7 @@ class Element:
                 continue
             if key in local:
                 decl = decl.with_start(local.pop(key))
-            sym = Symbol(key, decl, self)
-            self._symbols[key] = sym
-            object.__setattr__(self, key, sym.leaf)
+            self._declare_scalar(key, decl)
         for key, template in type(self)._templates.items():
             child = _build_child(key, template)
             if key in local:
@@ -148,10 +146,13 @@ class Element:
         if decl.shape != ():
             self._declare_array(name, decl, None)
         else:
-            sym = Symbol(name, decl, self)
-            self._symbols[name] = sym
-            object.__setattr__(self, name, sym.leaf)
+            self._declare_scalar(name, decl)
         return getattr(self, name)
+
+    def _declare_scalar(self, key: str, decl: Declaration) -> None:
+        sym = Symbol(key, decl, self)
+        self._symbols[key] = sym
+        object.__setattr__(self, key, sym.leaf)
 
     # -- structure -----------------------------------------------------------------------
     def add(self, name: str, element: Element) -> Element:

@@ -33,3 +33,7 @@ class Fast:
             a[:] = v
         self._eval()
         return self.res
+
+    def stats(self) -> dict:
+        """The function's statistics of the last call (e.g. an integrator's step counts)."""
+        return self._buf.stats()

@@ -185,3 +185,21 @@ def test_connector_with_array_variables_connects_elementwise():
     for k, (v0, c) in enumerate(zip([1.0, 2.0, 3.0], [1.0, 2.0, 4.0], strict=True)):
         exact = v0 * np.exp(-res.time / c)
         assert np.max(np.abs(res[f"caps.p.v[{k + 1}]"] - exact)) < 1e-8
+
+
+def test_declare_adds_an_instance_array_and_refuses_a_second_one():
+    class Chain(Component):
+        def __init__(self, n):
+            super().__init__()
+            self.declare("x", Variable(shape=n, start=[float(k + 1) for k in range(n)],
+                                       fixed=True))
+            self.declare("a", Parameter(2.0, unit="1/s"))
+
+        def equations(self):
+            yield der(self.x) == -self.a * self.x
+
+    m = Chain(4)
+    with pytest.raises(bg.errors.DuplicateNameError, match="'x' is already declared"):
+        m.declare("x", Variable())
+    res = bg.simulate(m, stop_time=1.0, interval=0.5, **TIGHT)
+    assert res["x[4]"][-1] == pytest.approx(4.0 * np.exp(-2.0), rel=1e-8)
