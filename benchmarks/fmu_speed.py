@@ -130,7 +130,7 @@ def main() -> None:
     print(f"  casadi IDAS          {t_idas * 1e3:9.2f} ms   ratio {t_idas / t_cvodes:5.2f}")
     print(f"  FMU ME (fmpy CVode)  {t_me * 1e3:9.2f} ms   ratio {t_me / t_cvodes:5.2f}   "
           f"max |dw| vs CVODES {np.max(np.abs(r_me['speed'][1:] - w_ref)):.2e}")
-    print(f"  FMU CS (SDIRK4)      {t_cs * 1e3:9.2f} ms   ratio {t_cs / t_cvodes:5.2f}   "
+    print(f"  FMU CS (BDF)         {t_cs * 1e3:9.2f} ms   ratio {t_cs / t_cvodes:5.2f}   "
           f"max |dw| vs CVODES {np.max(np.abs(r_cs['speed'][1:] - w_ref)):.2e}")
     print(f"  FMU CS, one DoStep   {t_c * 1e3:9.2f} ms   ratio {t_c / t_cvodes:5.2f}   "
           f"|dw(end)| vs CVODES {abs(w_end - w_ref[-1]):.2e}  (C solver without the fmpy loop)")

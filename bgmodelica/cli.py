@@ -287,9 +287,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="relative tolerance (default: the experiment annotation's "
                           "Tolerance of a Modelica model, else 1e-6)")
     sim.add_argument("--atol", type=float, default=1e-8)
-    sim.add_argument("--solver", choices=("idas", "cvodes", "auto"), default="idas",
-                     help="integrator: IDAS (DAEs, default), CVODES (explicit ODEs) or auto "
-                          "(CVODES when no algebraic unknowns are left)")
+    sim.add_argument("--solver", choices=("idas", "cvodes", "auto"), default="auto",
+                     help="integrator: auto (default: CVODES when no algebraic unknowns are "
+                          "left, IDAS otherwise), IDAS (DAEs) or CVODES (explicit ODEs)")
     sim.add_argument("--max-step", type=float, default=None, metavar="SECONDS",
                      help="largest internal step of the integrator [s]")
     sim.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,

@@ -40,7 +40,7 @@ _HINTS = {
 def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
              interval: float | None = None, params: dict[str, Any] | None = None, *,
              start_time: float = 0.0, rtol: float = 1e-6, atol: float = 1e-8,
-             max_step: float | None = None, max_steps: int = 100000, solver: str = "idas",
+             max_step: float | None = None, max_steps: int = 100000, solver: str = "auto",
              outputs: Sequence[str] | None = None, dynamic: bool = True,
              progress: Callable[[float], None] | None = None,
              inputs: Any = None, units: str = "error",
@@ -63,9 +63,9 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
     equation; NaN/Inf in the result :class:`SimulationError` naming the variable and time,
     with ``.result`` holding the rows before. params: overrides by dotted name
     of parameters, model inputs (held constant) or start values of variables. rtol/atol:
-    integrator tolerances; max_step: largest internal step [s]. solver: "idas" (default),
-    "cvodes" (ODE models only) or "auto" (CVODES when the reduced model is an explicit ODE,
-    no algebraic unknowns left; IDAS otherwise); ``result.meta["solver"]`` says which ran
+    integrator tolerances; max_step: largest internal step [s]. solver: "auto" (default:
+    CVODES when the reduced model is an explicit ODE, no algebraic unknowns left; IDAS
+    otherwise), "idas" or "cvodes" (ODE models only); ``result.meta["solver"]`` says which ran
     and ``meta["solver_choice"]`` whether it was chosen automatically. outputs: names to
     record (default: every variable).
     dynamic: allow dynamic state selection when index reduction left a choice whose

@@ -80,7 +80,7 @@ def _real(name: str, value: Any, *, allow_none: bool = False) -> float | None:
 
 def check_run_options(*, start_time: Any = 0.0, stop_time: Any = 1.0, interval: Any = None,
                       rtol: Any = 1e-6, atol: Any = 1e-8, max_step: Any = None,
-                      max_steps: Any = 100000, solver: Any = "idas") -> dict[str, Any]:
+                      max_steps: Any = 100000, solver: Any = "auto") -> dict[str, Any]:
     """Validate the options of :func:`bgmodelica.simulate`; returns them as floats/ints.
 
     Raises :class:`OptionError` naming the option: NaN, Inf, non-numbers, a stop time not

@@ -35,7 +35,7 @@ def export_fmu(spec: FmuSpec, out_dir: str | Path, fmi_version: int = 2,
     """Export ``spec`` as an FMU and return the path of ``<out_dir>/<model_name>.fmu``.
 
     ``fmi_version`` is 2 or 3; ``fmu_type`` is ``"me"`` (Model Exchange), ``"cs"``
-    (Co-Simulation with the embedded SDIRK solver) or ``"both"`` (one binary, both
+    (Co-Simulation with the embedded BDF solver) or ``"both"`` (one binary, both
     interfaces).  ``compiler`` overrides the C compiler (default: ``$CC``, ``cc``, ``gcc``,
     ``clang``).  Raises :class:`~bgmodelica.fmi.spec.FmuSpecError` for an inconsistent spec
     and :class:`~bgmodelica.fmi.build.FmuBuildError` when the binary cannot be built.

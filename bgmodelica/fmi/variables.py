@@ -151,7 +151,7 @@ def build_table(spec: FmuSpec, with_solver: bool, with_indicators: bool = False
         tol = add(None, "solver.tolerance", "solver", 0, "parameter", "tunable", "exact",
                   float(spec.tolerance), "1", min=SOLVER_TOLERANCE_MIN, max=SOLVER_TOLERANCE_MAX)
         tol.description = ("Relative (and, times the state nominal, absolute) error tolerance of "
-                           "the embedded SDIRK solver (Co-Simulation)")
+                           "the embedded BDF solver (Co-Simulation)")
         hmax = add(None, "solver.max_step", "solver", 1, "parameter", "tunable", "exact",
                    float(spec.default_max_step()), "s", min=1e-12)
         hmax.description = "Largest internal step of the embedded solver (Co-Simulation)"

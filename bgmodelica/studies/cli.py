@@ -206,8 +206,9 @@ def register(sub: Any, model_args: Callable[[argparse.ArgumentParser], None]) ->
     sw.add_argument("--interval", type=float, default=None, help="output step [s]")
     sw.add_argument("--rtol", type=float, default=1e-6)
     sw.add_argument("--atol", type=float, default=1e-8)
-    sw.add_argument("--solver", choices=("idas", "cvodes"), default="idas",
-                    help="integrator (cvodes: ODE models only, often faster)")
+    sw.add_argument("--solver", choices=("auto", "idas", "cvodes"), default="auto",
+                    help="integrator (auto: CVODES when the reduced model is an ODE, IDAS "
+                         "otherwise)")
     sw.add_argument("--scheduler", default="local",
                     help="'local' (a LocalCluster, default), 'serial' (no Dask) or the address "
                          "of a Dask scheduler, e.g. tcp://HOST:8786")

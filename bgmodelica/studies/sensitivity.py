@@ -275,7 +275,7 @@ def simulate_sensitivities(compiled: Any, dae: Any, p: np.ndarray, grid: np.ndar
                            max_step: float | None, max_steps: int, inputs: Any = None,
                            selection: Any = None, params: dict[str, Any] | None = None,
                            t_start: float | None = None, fd_step: float | None = None,
-                           solver: str = "idas"):
+                           solver: str = "auto"):
     """The :class:`~bgmodelica.result.Result` of ``simulate(..., sensitivities=names)``."""
     from ..result import Result
     from ..simulate import _output_indices
@@ -326,7 +326,7 @@ def finite_difference_sensitivities(model: Any, names: Sequence[str], *, stop_ti
                                     outputs: Sequence[str] | None = None, rtol: float = 1e-6,
                                     atol: float = 1e-8, max_step: float | None = None,
                                     max_steps: int = 100000, inputs: Any = None,
-                                    step: float | None = None, solver: str = "idas"):
+                                    step: float | None = None, solver: str = "auto"):
     """Central finite differences ``(y(p + h e_i) - y(p - h e_i)) / 2h`` of whole simulations,
     for any model (events included), on the output grid (the right limit at an event on the
     grid). ``step``: relative step h / max(|p_i|, 1e-8) (default ``rtol ** (1/3)``). The result

@@ -209,7 +209,7 @@ class Settings:
     interval: float | None
     rtol: float
     atol: float
-    solver: str = "idas"
+    solver: str = "auto"
     fixed: dict[str, Any] = field(default_factory=dict)
     max_steps: int = 100000
 
@@ -409,7 +409,7 @@ def sweep(model: Any, grid: Mapping[str, Any] | None = None, samples: int | None
           outputs: Sequence[str] | None = None, stop_time: float = 1.0,
           interval: float | None = None, *, params: Mapping[str, Any] | None = None,
           start_time: float = 0.0, rtol: float = 1e-6, atol: float = 1e-8,
-          solver: str = "idas", max_steps: int = 100000, sampling: str = "random",
+          solver: str = "auto", max_steps: int = 100000, sampling: str = "random",
           client: Any = None, scheduler: str | None = "local", workers: int | None = None,
           batch_size: int | None = None, progress: bool = True, ref: str | None = None,
           ref_kwargs: Mapping[str, Any] | None = None, ship: str = "auto",

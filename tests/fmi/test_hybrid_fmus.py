@@ -228,7 +228,7 @@ def test_rectifier_current_at_tight_tolerance(build):
     assert errors["v_out"] < 1e-9 and errors["i_d"] < 1e-6, errors
     cs = simulate_fmu(str(build("HalfWaveRectifier", 3, "cs")), **common)
     errors, _ = _errors(nat, cs, ["v_out", "i_d"], 1e-4)
-    # the embedded SDIRK solver stops at its 1e-12 tolerance floor
+    # the embedded BDF solver stops at its 1e-12 tolerance floor
     assert errors["v_out"] < 1e-9 and errors["i_d"] < 3e-6, errors
 
 

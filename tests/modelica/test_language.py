@@ -65,7 +65,7 @@ end Demo;
 def test_arrays_for_if_enumerations_constants():
     model = load_modelica_text(ARRAYS, "Demo.Arrays")
     assert model._symbols["v[1]"].decl.unit == "m/s"
-    res = _sim(model)
+    res = _sim(model, rtol=1e-8)
     t = np.asarray(res.time)
     for i in (1, 2, 3):
         np.testing.assert_allclose(res[f"x[{i}]"], np.exp(-i * t), rtol=1e-5)

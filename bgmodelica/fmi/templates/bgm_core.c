@@ -905,6 +905,7 @@ bgm_status bgm_set_state(bgm_inst *c, const char *fn, const void *state) {
     if (!bgm_check(c, fn, BGM_MODE_ANY)) return BGM_ERROR;
     if (!bgm_state_ok(c, fn, (const bgm_vars *)state)) return BGM_ERROR;
     memcpy(&c->v, state, sizeof(bgm_vars));
+    c->lu_ok = 0;
     c->cache_valid = 0;
     return BGM_OK;
 }

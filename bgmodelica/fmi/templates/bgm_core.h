@@ -68,6 +68,23 @@ enum {
 #define BGM_LOG_EVENTS 8u
 #define BGM_LOG_ALL 15u
 
+/* The embedded BDF solver's history between DoStep calls (bgm_solver.c).  Part of the FMU
+   state, so that a restored state repeats the same steps. */
+#define BGM_BDF_ROWS 8     /* differences 0..order+2 of the highest order, 5 */
+typedef struct {
+    int valid;             /* the history continues (snap_time, x, p, tolerance) */
+    int order;             /* current order 1..5 */
+    int n_equal;           /* steps taken with the current order and step size */
+    int jac_fresh;         /* jac was evaluated at the current step's predictor */
+    double t;              /* time of the newest solution point (may pass the step's end) */
+    double h;              /* current step size [s] */
+    double snap_time;      /* instance time and tolerance when the history was left */
+    double snap_tol;
+    double d[BGM_BDF_ROWS * BGM_NXA]; /* backward differences at spacing h, row k = D_k */
+    double jac[BGM_NXA * BGM_NXA];    /* d(xdot)/dx of the Newton iterations (column-major) */
+    double snap_x[BGM_NXA], snap_u[BGM_NUA], snap_p[BGM_NPA];
+} bgm_bdf;
+
 /* Everything that makes up the FMU state (copied verbatim by Get/SetFMUState). */
 typedef struct {
     unsigned magic;
@@ -82,7 +99,8 @@ typedef struct {
     double p[BGM_NPA];
     double solver_tol;     /* parameter solver.tolerance */
     double solver_hmax;    /* parameter solver.max_step */
-    double h_next;         /* step-size proposal of the embedded solver (0: none) */
+    double h_next;         /* step-size proposal of the embedded solver (0: restart it) */
+    bgm_bdf bdf;           /* the embedded solver's history (Co-Simulation) */
 #if BGM_HYBRID
     bgm_hyb_vars h;        /* discrete slots and event state (bgm_events.c) */
 #endif
@@ -125,6 +143,8 @@ typedef struct bgm_inst {
     double *ws;
     int *piv;
     long stat_steps, stat_rejected, stat_newton_fail, stat_f, stat_jac;
+    int lu_ok;                /* ws holds the LU of I - lu_c * v.bdf.jac */
+    double lu_c;
 #if BGM_HYBRID
     int early_return_allowed; /* FMI 3.0 Co-Simulation */
     bgm_hyb_work hw;          /* scratch of the event functions */

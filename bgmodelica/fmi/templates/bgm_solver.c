@@ -1,41 +1,60 @@
 /*
  * bgmodelica FMU runtime: the implicit solver embedded in Co-Simulation FMUs.
  *
- * Method: the 5-stage, order-4, L-stable and stiffly accurate SDIRK method of Hairer & Wanner
- * ("SDIRK4", Solving ODEs II, Table IV.6.5, gamma = 1/4) with its embedded order-3 solution
- * for the local error estimate.  All stages share the same diagonal coefficient, so one dense
- * LU factorisation of M = I - h*gamma*J per step serves every Newton iteration of every
- * stage.  J = d(xdot)/dx comes from the CasADi-generated Jacobian and is evaluated once per
- * step attempt (simplified Newton).  The error estimate is filtered through M^{-1}
- * (Shampine's trick) so that stiff components do not inflate it.  Step-size control is the
- * usual h_new = h * clamp(0.9 * err^(-1/4), 0.2, 5), limited by solver.max_step and the end
- * of the communication step; the last accepted proposal is kept across DoStep calls.
- * Inputs are held constant over a communication step (canInterpolateInputs = false).
+ * Method: variable-order (1..5), variable-step backward differentiation formulas in the
+ * quasi-constant step-size form of Shampine & Reichelt (the numerical differentiation
+ * formulas, NDF, of "The MATLAB ODE Suite", SIAM J. Sci. Comput. 18, 1997, with Klopfenstein's
+ * kappa coefficients): the solution history is a table D of backward differences at spacing
+ * h, re-expressed exactly for a new step size when h changes.  Each step predicts from D,
+ * corrects with a simplified Newton iteration on (I - c J) with c = h / alpha[order] (one
+ * dense LU reused over steps while it converges; J = d(xdot)/dx from the CasADi-generated
+ * Jacobian, re-evaluated only when Newton stalls), and estimates the local error from the
+ * corrector's update.  After order+1 steps at the same size the order and size change to
+ * whichever of order-1, order, order+1 allows the largest step.
+ *
+ * Between DoStep calls the history is kept when nothing changed (time, states, inputs up to
+ * rounding, parameters, tolerance): a step may then run past the communication point and the
+ * state there is interpolated from D, so communication points do not cut the solver's steps.
+ * New inputs or parameters, set states, an event or a Reset restart it at order 1 (inputs
+ * are held over each communication step, so a new input is a discontinuity the history must
+ * not straddle).  The history is part of the FMU state: a restored state repeats the same
+ * steps.  Hybrid models stop every step at the event or communication time instead (their
+ * relations are checked over each step).
  */
 #include <math.h>
 #include <string.h>
 
 #include "bgm_core.h"
 
-#define NS 5
-static const double G = 0.25;
-static const double C[NS] = {0.25, 0.75, 11.0 / 20.0, 0.5, 1.0};
-static const double A[NS][NS] = {
-    {0.25, 0, 0, 0, 0},
-    {0.5, 0.25, 0, 0, 0},
-    {17.0 / 50.0, -1.0 / 25.0, 0.25, 0, 0},
-    {371.0 / 1360.0, -137.0 / 2720.0, 15.0 / 544.0, 0.25, 0},
-    {25.0 / 24.0, -49.0 / 48.0, 125.0 / 16.0, -85.0 / 12.0, 0.25}};
-/* b - bhat: b is the last row of A (stiffly accurate), bhat the embedded order-3 weights */
-static const double E[NS] = {25.0 / 24.0 - 59.0 / 48.0, -49.0 / 48.0 + 17.0 / 96.0,
-                             125.0 / 16.0 - 225.0 / 32.0, 0.0, 0.25};
-
-#define MAX_NEWTON 10
+#define MAX_ORDER 5
+#define NEWTON_MAXITER 4
+#define MIN_FACTOR 0.2
+#define MAX_FACTOR 10.0
 #define MAX_SUBSTEPS 1000000L
+#define EPS 2.220446049250313e-16
 
+/* NDF coefficients: kappa, gamma_k = sum_{j<=k} 1/j, alpha = (1 - kappa) gamma, and the
+   error constants kappa gamma + 1/(k+1) */
+static const double KAPPA[MAX_ORDER + 1] = {0.0, -0.1850, -1.0 / 9.0, -0.0823, -0.0415, 0.0};
+static double GAMMA[MAX_ORDER + 2], ALPHA[MAX_ORDER + 1], ERRC[MAX_ORDER + 2];
+static int coefficients_ready = 0;
+
+static void init_coefficients(void) {
+    int k;
+    GAMMA[0] = 0.0;
+    for (k = 1; k <= MAX_ORDER + 1; k++) GAMMA[k] = GAMMA[k - 1] + 1.0 / k;
+    for (k = 0; k <= MAX_ORDER; k++) {
+        ALPHA[k] = (1.0 - KAPPA[k]) * GAMMA[k];
+        ERRC[k] = KAPPA[k] * GAMMA[k] + 1.0 / (k + 1);
+    }
+    ERRC[MAX_ORDER + 1] = 1.0 / (MAX_ORDER + 2);
+    coefficients_ready = 1;
+}
+
+/* workspace: LU and 9 vectors (the history itself is FMU state, bgm_core.h) */
 size_t bgm_solver_workspace(void) {
     size_t n = BGM_NXA;
-    return 13 * n + 2 * n * n;
+    return 9 * n + n * n;
 }
 
 /* LU factorisation with partial pivoting of the row-major n x n matrix a (in place). */
@@ -58,10 +77,10 @@ static int lu_factor(double *a, int *piv, int n) {
                 a[p * n + j] = t;
             }
         for (i = k + 1; i < n; i++) {
-            double l = a[i * n + k] / a[k * n + k];
-            a[i * n + k] = l;
-            if (l != 0.0)
-                for (j = k + 1; j < n; j++) a[i * n + j] -= l * a[k * n + j];
+            double m = a[i * n + k] / a[k * n + k];
+            a[i * n + k] = m;
+            if (m != 0.0)
+                for (j = k + 1; j < n; j++) a[i * n + j] -= m * a[k * n + j];
         }
     }
     return 0;
@@ -70,21 +89,21 @@ static int lu_factor(double *a, int *piv, int n) {
 static void lu_solve(const double *a, const int *piv, int n, double *b) {
     int i, j;
     for (i = 0; i < n; i++) {
+        double t;
         if (piv[i] != i) {
-            double t = b[i];
+            t = b[i];
             b[i] = b[piv[i]];
             b[piv[i]] = t;
         }
-    }
-    for (i = 1; i < n; i++)
         for (j = 0; j < i; j++) b[i] -= a[i * n + j] * b[j];
+    }
     for (i = n - 1; i >= 0; i--) {
         for (j = i + 1; j < n; j++) b[i] -= a[i * n + j] * b[j];
         b[i] /= a[i * n + i];
     }
 }
 
-/* weighted RMS norm of v with weights atol_i + rtol*|ref_i| */
+/* root mean square of v ./ sc */
 static double wnorm(const double *v, const double *sc, int n) {
     double s = 0.0;
     int i;
@@ -95,202 +114,357 @@ static double wnorm(const double *v, const double *sc, int n) {
     return n > 0 ? sqrt(s / n) : 0.0;
 }
 
+/* D[0..order] <- the same interpolating polynomial as differences at spacing factor * h:
+   D <- (R U)^T D with R = R(order, factor), U = R(order, 1) (Shampine & Reichelt, eq. 2.3) */
+static void change_d(double *D, int order, double factor, int n) {
+    double R[MAX_ORDER + 1][MAX_ORDER + 1], U[MAX_ORDER + 1][MAX_ORDER + 1];
+    double tmp[MAX_ORDER + 1];
+    double RU[MAX_ORDER + 1][MAX_ORDER + 1];
+    int i, j, k, q = order + 1;
+    for (k = 0; k < 2; k++) {
+        double (*M)[MAX_ORDER + 1] = k == 0 ? R : U;
+        double f = k == 0 ? factor : 1.0;
+        for (j = 0; j < q; j++) M[0][j] = 1.0;
+        for (i = 1; i < q; i++) {
+            M[i][0] = 0.0;
+            for (j = 1; j < q; j++) M[i][j] = M[i - 1][j] * (i - 1 - f * j) / i;
+        }
+    }
+    for (i = 0; i < q; i++)
+        for (j = 0; j < q; j++) {
+            double acc = 0.0;
+            for (k = 0; k < q; k++) acc += R[i][k] * U[k][j];
+            RU[i][j] = acc;
+        }
+    for (k = 0; k < n; k++) {
+        for (j = 0; j < q; j++) {
+            double acc = 0.0;
+            for (i = 0; i < q; i++) acc += RU[i][j] * D[i * n + k];
+            tmp[j] = acc;
+        }
+        for (j = 0; j < q; j++) D[j * n + k] = tmp[j];
+    }
+}
+
+/* y(t) from the difference table (newest point t_new, spacing h, current order) */
+static void interpolate(const double *D, int order, double t_new, double h, double t, int n,
+                        double *y) {
+    double p[MAX_ORDER];
+    int i, j;
+    double acc = 1.0;
+    for (j = 0; j < order; j++) {
+        acc *= (t - (t_new - h * j)) / (h * (j + 1));
+        p[j] = acc;
+    }
+    for (i = 0; i < n; i++) {
+        double v = D[i];
+        for (j = 1; j <= order; j++) v += D[j * n + i] * p[j - 1];
+        y[i] = v;
+    }
+}
+
+static int same(const double *a, const double *b, size_t n) {
+    return n == 0 || memcmp(a, b, n * sizeof(double)) == 0;
+}
+
+/* equal up to rounding (an importer's interpolation of a constant signal) */
+static int nearly_same(const double *a, const double *b, size_t n) {
+    size_t i;
+    for (i = 0; i < n; i++)
+        if (fabs(a[i] - b[i]) > 4.0 * EPS * (fabs(a[i]) > 1.0 ? fabs(a[i]) : 1.0)) return 0;
+    return 1;
+}
+
 bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
     const int n = BGM_NX;
-    double *ws = c->ws;
-    double *x0 = ws, *Y = x0 + BGM_NXA, *s = Y + BGM_NXA, *F = s + BGM_NXA;
-    double *err = F + BGM_NXA, *sc = err + BGM_NXA, *f0 = sc + BGM_NXA, *tmp = f0 + BGM_NXA;
-    double *K = tmp + BGM_NXA, *J = K + NS * BGM_NXA, *M = J + BGM_NXA * BGM_NXA;
-    double rtol = c->v.solver_tol, hmax = c->v.solver_hmax;
-    double t = c->v.time, h;
+    bgm_bdf *b = &c->v.bdf;
+    double *D = b->d, *J = b->jac, *LU = c->ws, *ypred = LU + BGM_NXA * BGM_NXA;
+    double *psi = ypred + BGM_NXA, *d = psi + BGM_NXA, *ynew = d + BGM_NXA, *f = ynew + BGM_NXA;
+    double *dy = f + BGM_NXA, *sc = dy + BGM_NXA, *tmp = sc + BGM_NXA, *y0 = tmp + BGM_NXA;
+    double rtol = c->v.solver_tol, hmax = c->v.solver_hmax, newton_tol, t_bound = t_end;
     long substeps = 0;
-    int have_f0 = 0, last_rejected = 0, i, j, st, rc;
+#if BGM_HYBRID
+    const int overshoot = 0;
+#else
+    const int overshoot = 1;
+#endif
+    int i, j;
     const char *why = "";
 
+    if (!coefficients_ready) init_coefficients();
     if (c->exp_tol_defined && c->exp_tol > 0.0 && c->exp_tol < rtol) rtol = c->exp_tol;
     if (n == 0) {
         c->v.time = t_end;
         c->cache_valid = 0;
         return BGM_OK;
     }
-    memcpy(x0, c->v.x, n * sizeof(double));
+    newton_tol = sqrt(rtol) < 0.03 ? sqrt(rtol) : 0.03;
+    if (newton_tol < 10.0 * EPS / rtol) newton_tol = 10.0 * EPS / rtol;
+    if (overshoot) t_bound = INFINITY; /* the same steps whatever the importer's stop time */
 
-    h = c->v.h_next;
-    if (!(h > 0.0)) {
-        /* initial step guess from the size of x and xdot */
-        double d0, d1;
-        if (bgm_call_xdot(c, t, x0, f0)) goto eval_failed;
-        have_f0 = 1;
-        for (i = 0; i < n; i++) sc[i] = rtol * bgm_x_nominal[i] + rtol * fabs(x0[i]);
-        d0 = wnorm(x0, sc, n);
-        d1 = wnorm(f0, sc, n);
-        h = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
-        if (h > 0.1 * (t_end - t)) h = 0.1 * (t_end - t);
-        if (h < 1e-10 * (t_end - t)) h = 1e-10 * (t_end - t);
+    /* continue the history (a step may already have passed the communication point), or
+       restart at order 1 from (time, x) */
+    if (!(b->valid && c->v.h_next > 0.0 && fabs(b->snap_time - c->v.time) <= 1e-11 * (fabs(c->v.time) > 1.0 ? fabs(c->v.time) : 1.0) &&
+          b->snap_tol == rtol &&
+        same(b->snap_x, c->v.x, n) && same(b->snap_p, c->v.p, BGM_NP) &&
+        nearly_same(b->snap_u, c->v.u, BGM_NU) &&
+          b->t >= b->snap_time && b->t <= t_bound)) {
+        double t0 = c->v.time, h0, h1, d0, d1, d2, span = t_bound - t0;
+        b->valid = 0;
+        memcpy(y0, c->v.x, n * sizeof(double));
+        if (bgm_call_xdot(c, t0, y0, f)) goto eval_failed;
+        /* initial step (Hairer, Norsett & Wanner I, II.4): h0 from |y|/|y'|, h1 from y'' */
+        for (i = 0; i < n; i++) sc[i] = rtol * bgm_x_nominal[i] + rtol * fabs(y0[i]);
+        d0 = wnorm(y0, sc, n);
+        d1 = wnorm(f, sc, n);
+        h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
+        if (h0 > span) h0 = span;
+        if (h0 > hmax) h0 = hmax;
+        for (i = 0; i < n; i++) tmp[i] = y0[i] + h0 * f[i];
+        if (bgm_call_xdot(c, t0 + h0, tmp, dy)) goto eval_failed;
+        for (i = 0; i < n; i++) dy[i] = (dy[i] - f[i]) / h0;
+        d2 = wnorm(dy, sc, n);
+        h1 = (d1 <= 1e-15 && d2 <= 1e-15) ? (h0 * 1e-3 > 1e-6 ? h0 * 1e-3 : 1e-6)
+                                          : sqrt(0.01 / (d1 > d2 ? d1 : d2));
+        b->h = 100.0 * h0 < h1 ? 100.0 * h0 : h1;
+        if (c->v.h_next > 0.0 && c->v.h_next < b->h) b->h = c->v.h_next;
+        if (b->h > hmax) b->h = hmax;
+        if (b->h > span) b->h = span;
+        memcpy(D, y0, n * sizeof(double));
+        for (i = 0; i < n; i++) D[n + i] = f[i] * b->h;
+        for (i = 2 * n; i < BGM_BDF_ROWS * n; i++) D[i] = 0.0;
+        b->t = t0;
+        b->order = 1;
+        b->n_equal = 0;
+        c->lu_ok = 0;
+        if (bgm_call_jacx(c, t0, y0, J)) goto eval_failed;
+        b->jac_fresh = 1;
+        b->valid = 1;
     }
 
-    while (t < t_end) {
-        double hs = h, hmin, en, fac;
-        int clipped = 0, newton_ok = 1;
-        if (hs > hmax) hs = hmax;
-        if (t + hs >= t_end || t + 1.01 * hs >= t_end) {
-            hs = t_end - t;
-            clipped = 1;
-        }
-        hmin = 1e-14 * (fabs(t) > 1.0 ? fabs(t) : 1.0);
-        if (hs < hmin && !clipped) {
-            bgm_error(c, "%s: step size %g too small at t=%.17g (%s); the model may be "
-                      "singular or need a looser solver.tolerance", fn, hs, t, why);
-            return BGM_ERROR;
-        }
+    /* (a remainder of a few ulps of t_end is interpolated, not stepped) */
+    while (t_end - b->t > 10.0 * EPS * (fabs(t_end) > 1.0 ? fabs(t_end) : 1.0)) {
+        double h, t_new, c_coef, err_norm, safety, hmin;
+        int order = b->order, converged = 0, n_iter = 0, clipped = 0;
+        double h_natural = b->h;
+
         if (++substeps > MAX_SUBSTEPS) {
             bgm_error(c, "%s: more than %ld internal steps in one communication step at t=%g",
-                      fn, MAX_SUBSTEPS, t);
-            return BGM_ERROR;
+                      fn, MAX_SUBSTEPS, b->t);
+            goto fail;
         }
-        if (!have_f0) {
-            if (bgm_call_xdot(c, t, x0, f0)) goto eval_failed;
-            have_f0 = 1;
+        if (b->h > hmax) {
+            change_d(D, order, hmax / b->h, n);
+            b->h = hmax;
+            b->n_equal = 0;
+            c->lu_ok = 0;
+            h_natural = hmax;
         }
-        rc = bgm_call_jacx(c, t, x0, J);
-        if (rc) goto eval_failed;
-        /* M = I - hs*G*J ; J is column-major from CasADi, M row-major */
-        for (i = 0; i < n; i++)
-            for (j = 0; j < n; j++) M[i * n + j] = (i == j ? 1.0 : 0.0) - hs * G * J[i + j * n];
-        if (lu_factor(M, c->piv, n)) {
-            why = "singular iteration matrix";
-            c->stat_newton_fail++;
-            h = 0.25 * hs;
-            last_rejected = 1;
-            if (h < hmin) {
-                bgm_error(c, "%s: singular iteration matrix at t=%.17g", fn, t);
-                return BGM_ERROR;
-            }
-            continue;
+        hmin = 10.0 * EPS * (fabs(b->t) > 1.0 ? fabs(b->t) : 1.0);
+        if (b->t + b->h > t_bound || (!overshoot && b->t + 1.01 * b->h >= t_bound)) {
+            double hb = t_bound - b->t;
+            change_d(D, order, hb / b->h, n);
+            b->h = hb;
+            c->lu_ok = 0;
+            clipped = 1;
         }
-        for (i = 0; i < n; i++) sc[i] = rtol * bgm_x_nominal[i] + rtol * fabs(x0[i]);
+        if (b->h < hmin) {
+            bgm_error(c, "%s: step size %g too small at t=%.17g (%s); the model may be "
+                      "singular or need a looser solver.tolerance", fn, b->h, b->t, why);
+            goto fail;
+        }
+        h = b->h;
+        t_new = clipped ? t_bound : b->t + h;
 
-        for (st = 0; st < NS && newton_ok; st++) {
-            double ts = t + C[st] * hs, nrm_old = 0.0;
-            const double *kprev = st == 0 ? f0 : K + (st - 1) * n;
-            int it, converged = 0;
-            for (i = 0; i < n; i++) {
-                double acc = 0.0;
-                for (j = 0; j < st; j++) acc += A[st][j] * K[j * n + i];
-                s[i] = x0[i] + hs * acc;
-                Y[i] = s[i] + hs * G * kprev[i];
+        /* predictor, and psi = sum gamma_k D_k / alpha */
+        for (i = 0; i < n; i++) {
+            double yp = 0.0, ps = 0.0;
+            for (j = 0; j <= order; j++) yp += D[j * n + i];
+            for (j = 1; j <= order; j++) ps += GAMMA[j] * D[j * n + i];
+            ypred[i] = yp;
+            psi[i] = ps / ALPHA[order];
+            sc[i] = rtol * bgm_x_nominal[i] + rtol * fabs(yp);
+        }
+        c_coef = h / ALPHA[order];
+
+        /* simplified Newton on y - c f(t_new, y) = ypred - psi, in the increment d */
+        for (;;) {
+            double dy_old = 0.0;
+            int k, fresh = b->jac_fresh;
+            if (!c->lu_ok || c->lu_c != c_coef) {
+                for (i = 0; i < n; i++)
+                    for (j = 0; j < n; j++)
+                        LU[i * n + j] = (i == j ? 1.0 : 0.0) - c_coef * J[i + j * n];
+                if (lu_factor(LU, c->piv, n)) {
+                    c->lu_ok = 0;
+                    why = "singular iteration matrix";
+                    if (fresh) break;
+                    if (bgm_call_jacx(c, t_new, ypred, J)) goto eval_failed;
+                    b->jac_fresh = 1;
+                    continue;
+                }
+                c->lu_ok = 1;
+                c->lu_c = c_coef;
             }
-            for (it = 0; it < MAX_NEWTON; it++) {
-                double nrm;
-                rc = bgm_call_xdot(c, ts, Y, F);
+            memcpy(ynew, ypred, n * sizeof(double));
+            memset(d, 0, n * sizeof(double));
+            converged = 0;
+            for (k = 0; k < NEWTON_MAXITER; k++) {
+                double dy_norm, rate = -1.0;
+                int rc = bgm_call_xdot(c, t_new, ynew, f);
                 if (rc == 1) goto eval_failed;
                 if (rc == 2) {
                     why = "non-finite model evaluation during Newton iteration";
                     break;
                 }
-                for (i = 0; i < n; i++) tmp[i] = -(Y[i] - s[i] - hs * G * F[i]);
-                lu_solve(M, c->piv, n, tmp);
-                for (i = 0; i < n; i++) Y[i] += tmp[i];
-                nrm = wnorm(tmp, sc, n);
-                if (!isfinite(nrm)) {
+                for (i = 0; i < n; i++) dy[i] = c_coef * f[i] - psi[i] - d[i];
+                lu_solve(LU, c->piv, n, dy);
+                dy_norm = wnorm(dy, sc, n);
+                if (!isfinite(dy_norm)) {
                     why = "Newton iteration diverged";
                     break;
                 }
-                if (it == 0) {
-                    if (nrm <= 1e-3) {
-                        converged = 1;
-                        break;
-                    }
-                } else {
-                    double theta = nrm / nrm_old;
-                    if (theta >= 0.99) {
-                        why = "Newton iteration diverged";
-                        break;
-                    }
-                    if (theta / (1.0 - theta) * nrm <= 0.03) {
-                        converged = 1;
+                if (k > 0) {
+                    rate = dy_norm / dy_old;
+                    if (rate >= 1.0 ||
+                        pow(rate, NEWTON_MAXITER - k) / (1.0 - rate) * dy_norm > newton_tol) {
+                        why = "Newton iteration did not converge";
                         break;
                     }
                 }
-                nrm_old = nrm;
+                for (i = 0; i < n; i++) {
+                    ynew[i] += dy[i];
+                    d[i] += dy[i];
+                }
+                n_iter = k + 1;
+                if (dy_norm == 0.0 || (rate >= 0.0 && rate / (1.0 - rate) * dy_norm < newton_tol)) {
+                    converged = 1;
+                    break;
+                }
+                dy_old = dy_norm;
             }
-            if (!converged) {
-                if (it == MAX_NEWTON) why = "Newton iteration did not converge";
-                newton_ok = 0;
-                break;
-            }
-            for (i = 0; i < n; i++) K[st * n + i] = (Y[i] - s[i]) / (hs * G);
+            if (converged || fresh) break;
+            /* a stale Jacobian: refresh it at the predictor and try again */
+            if (bgm_call_jacx(c, t_new, ypred, J)) goto eval_failed;
+            b->jac_fresh = 1;
+            c->lu_ok = 0;
         }
-        if (!newton_ok) {
+        if (!converged) {
             c->stat_newton_fail++;
-            h = 0.25 * hs;
-            last_rejected = 1;
-            if (h < hmin) {
-                bgm_error(c, "%s: step size %g too small at t=%.17g (%s)", fn, h, t, why);
-                return BGM_ERROR;
-            }
+            change_d(D, order, 0.5, n);
+            b->h = 0.5 * h;
+            b->n_equal = 0;
+            c->lu_ok = 0;
             continue;
         }
-        /* Y holds the new solution (stiffly accurate); local error estimate */
-        for (i = 0; i < n; i++) {
-            double acc = 0.0;
-            for (st = 0; st < NS; st++) acc += E[st] * K[st * n + i];
-            err[i] = hs * acc;
+
+        /* local error estimate */
+        for (i = 0; i < n; i++) sc[i] = rtol * bgm_x_nominal[i] + rtol * fabs(ynew[i]);
+        for (i = 0; i < n; i++) tmp[i] = ERRC[order] * d[i];
+        err_norm = wnorm(tmp, sc, n);
+        safety = 0.9 * (2 * NEWTON_MAXITER + 1) / (2 * NEWTON_MAXITER + n_iter);
+        if (!(err_norm <= 1.0)) {
+            double factor = isfinite(err_norm) ? safety * pow(err_norm, -1.0 / (order + 1))
+                                               : MIN_FACTOR;
+            if (factor < MIN_FACTOR) factor = MIN_FACTOR;
+            c->stat_rejected++;
+            why = "error test failed repeatedly";
+            change_d(D, order, factor, n);
+            b->h = h * factor;
+            b->n_equal = 0;
+            c->lu_ok = 0;
+            continue;
         }
-        lu_solve(M, c->piv, n, err);
-        for (i = 0; i < n; i++) {
-            double ref = fabs(x0[i]) > fabs(Y[i]) ? fabs(x0[i]) : fabs(Y[i]);
-            sc[i] = rtol * bgm_x_nominal[i] + rtol * ref;
-        }
-        en = wnorm(err, sc, n);
-        if (!isfinite(en)) en = 1e10;
-        fac = en > 0.0 ? 0.9 * pow(en, -0.25) : 5.0;
-        if (fac > 5.0) fac = 5.0;
-        if (fac < 0.2) fac = 0.2;
-        if (en <= 1.0) {
+
+        /* accepted: update the differences */
+        c->stat_steps++;
+        {
+            double t_old = b->t;
+            memcpy(y0, D, n * sizeof(double)); /* y at t_old */
+            for (i = 0; i < n; i++) {
+                D[(order + 2) * n + i] = d[i] - D[(order + 1) * n + i];
+                D[(order + 1) * n + i] = d[i];
+            }
+            for (j = order; j >= 0; j--)
+                for (i = 0; i < n; i++) D[j * n + i] += D[(j + 1) * n + i];
+            b->t = t_new;
+            b->jac_fresh = 0;
+            b->n_equal++;
 #if BGM_HYBRID
             /* a relation left its frozen value during this step: stop, the caller locates it */
-            int crossed = bgm_hyb_step_check(c, t, x0, clipped ? t_end : t + hs, Y);
-#endif
-            c->stat_steps++;
-            t = clipped ? t_end : t + hs;
-            memcpy(x0, Y, n * sizeof(double));
-            memcpy(f0, K + (NS - 1) * n, n * sizeof(double)); /* FSAL: f(t+h, Y5) */
-            if (last_rejected && fac > 1.0) fac = 1.0;
-            last_rejected = 0;
-            /* a step shortened to hit t_end does not shrink a good proposal */
-            if (clipped && hs < h && fac >= 1.0) {
-                if (hs * fac > h) h = hs * fac;
-            } else {
-                h = hs * fac;
-            }
-            /* commit the accepted step: DoStep failures later keep a consistent state */
-            memcpy(c->v.x, x0, n * sizeof(double));
-            c->v.time = t;
-#if BGM_HYBRID
-            if (crossed) {
-                c->v.h_next = h;
+            if (bgm_hyb_step_check(c, t_old, y0, t_new, D)) {
+                c->v.time = t_new;
+                memcpy(c->v.x, D, n * sizeof(double));
+                c->v.h_next = b->h;
+                b->valid = 0;
                 c->cache_valid = 0;
                 return BGM_OK;
             }
+#else
+            (void)t_old;
 #endif
-        } else {
-            c->stat_rejected++;
-            last_rejected = 1;
-            h = hs * (fac < 1.0 ? fac : 0.5);
-            why = "error test failed repeatedly";
+        }
+        if (clipped && h < h_natural) {
+            /* a step shortened to land on the bound: keep the natural step size */
+            change_d(D, order, h_natural / h, n);
+            b->h = h_natural;
+            b->n_equal = 0;
+            c->lu_ok = 0;
+        } else if (b->n_equal >= order + 1) {
+            /* order and step-size selection among order-1, order, order+1 */
+            double em = INFINITY, ep = INFINITY, fm, f0, fp, factor;
+            if (order > 1) {
+                for (i = 0; i < n; i++) tmp[i] = ERRC[order - 1] * D[order * n + i];
+                em = wnorm(tmp, sc, n);
+            }
+            if (order < MAX_ORDER) {
+                for (i = 0; i < n; i++) tmp[i] = ERRC[order + 1] * D[(order + 2) * n + i];
+                ep = wnorm(tmp, sc, n);
+            }
+            fm = em > 0.0 ? pow(em, -1.0 / order) : INFINITY;
+            f0 = err_norm > 0.0 ? pow(err_norm, -1.0 / (order + 1)) : INFINITY;
+            fp = ep > 0.0 ? pow(ep, -1.0 / (order + 2)) : INFINITY;
+            if (order <= 1) fm = 0.0;
+            if (order >= MAX_ORDER) fp = 0.0;
+            factor = f0;
+            if (fm > factor) {
+                factor = fm;
+                order--;
+            }
+            if (fp > factor) {
+                factor = fp;
+                order = b->order + 1;
+            }
+            factor *= safety;
+            if (factor > MAX_FACTOR) factor = MAX_FACTOR;
+            b->order = order;
+            change_d(D, order, factor, n);
+            b->h *= factor;
+            b->n_equal = 0;
+            c->lu_ok = 0;
         }
     }
+
+    /* the state at t_end: the newest point, or interpolated when a step ran past it */
+    if (b->t != t_end) interpolate(D, b->order, b->t, b->h, t_end, n, c->v.x);
+    else memcpy(c->v.x, D, n * sizeof(double));
     c->v.time = t_end;
-    c->v.h_next = h;
+    c->v.h_next = b->h;
     c->cache_valid = 0;
-    bgm_log(c, BGM_OK, "logSolver", "%s: reached t=%g, next step %g, %ld steps so far", fn,
-            t_end, h, c->stat_steps);
+    b->snap_time = t_end;
+    b->snap_tol = rtol;
+    memcpy(b->snap_x, c->v.x, n * sizeof(double));
+    if (BGM_NU > 0) memcpy(b->snap_u, c->v.u, BGM_NU * sizeof(double));
+    if (BGM_NP > 0) memcpy(b->snap_p, c->v.p, BGM_NP * sizeof(double));
+    bgm_log(c, BGM_OK, "logSolver", "%s: reached t=%g (solver at t=%g, order %d, step %g), "
+            "%ld steps so far", fn, t_end, b->t, b->order, b->h, c->stat_steps);
     return BGM_OK;
 
 eval_failed:
     bgm_error(c, "%s: model evaluation failed or returned NaN/Inf at t=%.17g (state or "
-              "Jacobian); check inputs and parameters", fn, t);
+              "Jacobian); check inputs and parameters", fn, b->t);
+fail:
+    b->valid = 0;
     c->cache_valid = 0;
     return BGM_ERROR;
 }

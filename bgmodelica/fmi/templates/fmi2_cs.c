@@ -1,6 +1,6 @@
 /*
  * bgmodelica FMU runtime: FMI 2.0 Co-Simulation functions.  DoStep integrates with the
- * embedded SDIRK solver (bgm_solver.c); it is synchronous (never returns fmi2Pending) and
+ * embedded BDF solver (bgm_solver.c); it is synchronous (never returns fmi2Pending) and
  * inputs are held constant over a communication step.
  * Written for bgmodelica from the FMI 2.0.x specification.
  */

@@ -1,6 +1,6 @@
 /*
  * bgmodelica FMU runtime: FMI 3.0 Co-Simulation functions.  DoStep integrates with the
- * embedded SDIRK solver (bgm_solver.c); no early return, no intermediate update; Event Mode
+ * embedded BDF solver (bgm_solver.c); no early return, no intermediate update; Event Mode
  * is supported trivially (the model has no events) when instantiated with eventModeUsed.
  * Written for bgmodelica from the FMI 3.0 specification.
  */
