@@ -176,8 +176,13 @@ def jit_rows(repeat: int) -> dict:
 
 def fmu_cs_vs_native(repeat: int) -> dict:
     """The robot exported as a Co-Simulation FMU and run by fmpy (10 s, 10 ms communication
-    step) against ``simulate`` of the same compiled model."""
-    from fmpy import simulate_fmu
+    step) against ``simulate`` of the same compiled model (its default solver choice, same
+    tolerance). ``simulate_fmu`` unzips the FMU, parses its model description and loads the
+    library at every call (a fixed cost of about 25 ms here); the run on the extracted folder
+    and a loop over fmpy's low-level ``FMU2Slave`` (instantiated once; reset, initialize and
+    1000 ``doStep`` + ``getReal`` per run) are reported too."""
+    from fmpy import extract, read_model_description, simulate_fmu
+    from fmpy.fmi2 import FMU2Slave
 
     from bgmodelica import compile, simulate
     from bgmodelica.fmi.from_model import export_model
@@ -188,11 +193,37 @@ def fmu_cs_vs_native(repeat: int) -> dict:
         fmu = export_model(compiled, tmp, fmi_version=2, fmu_type="cs", stop_time=STOP)
         t_fmu = best_time(lambda: simulate_fmu(str(fmu), stop_time=STOP, output_interval=DT,
                                                output=["arm.q1", "arm.q2"]), repeat)
+        folder = extract(str(fmu), unzipdir=str(Path(tmp) / "unzipped"))
+        t_dir = best_time(lambda: simulate_fmu(folder, stop_time=STOP, output_interval=DT,
+                                               output=["arm.q1", "arm.q2"]), repeat)
+        md = read_model_description(folder)
+        refs = [v.valueReference for v in md.modelVariables if v.name in ("arm.q1", "arm.q2")]
+        slave = FMU2Slave(guid=md.guid, unzipDirectory=folder, instanceName="robot",
+                          modelIdentifier=md.coSimulation.modelIdentifier)
+        slave.instantiate()
+        steps = int(round(STOP / DT))
+
+        def loop() -> np.ndarray:
+            slave.reset()
+            slave.setupExperiment(startTime=0.0, stopTime=STOP)
+            slave.enterInitializationMode()
+            slave.exitInitializationMode()
+            out = np.empty((steps + 1, len(refs)))
+            out[0] = slave.getReal(refs)
+            for k in range(steps):
+                slave.doStep(currentCommunicationPoint=k * DT, communicationStepSize=DT)
+                out[k + 1] = slave.getReal(refs)
+            return out
+
+        t_loop = best_time(loop, repeat)
+        slave.terminate()
+        slave.freeInstance()
     t_native = best_time(lambda: simulate(compiled, stop_time=STOP, interval=DT, rtol=1e-6,
-                                          atol=1e-8), repeat)
-    print(f"  robot CS FMU under fmpy {t_fmu:.4f} s, native simulate {t_native:.4f} s",
-          flush=True)
-    return {"fmu_cs_fmpy": t_fmu, "native": t_native, "ratio": t_fmu / t_native}
+                                          atol=1e-6), repeat)
+    print(f"  robot CS FMU under fmpy {t_fmu:.4f} s ({t_dir:.4f} s extracted, "
+          f"{t_loop:.4f} s FMU2Slave loop), native simulate {t_native:.4f} s", flush=True)
+    return {"fmu_cs_fmpy": t_fmu, "fmu_cs_fmpy_extracted": t_dir, "fmu_cs_fmpy_loop": t_loop,
+            "native": t_native, "ratio": t_fmu / t_native, "ratio_loop": t_loop / t_native}
 
 
 def compile_rows(sizes: list[int]) -> dict:
@@ -290,9 +321,13 @@ def table(report: dict) -> str:
                      f"; pays off after {r['crossover_runs']} runs | |")
     fc = report.get("fmu_cs")
     if fc:
-        lines.append(f"| robot CS FMU under fmpy, 10 s | {fc['fmu_cs_fmpy'] * 1e3:.1f} ms | "
-                     f"native `simulate` {fc['native'] * 1e3:.1f} ms | {fc['ratio']:.2f}x | "
+        lines.append(f"| robot CS FMU, fmpy `simulate_fmu`, 10 s | {fc['fmu_cs_fmpy'] * 1e3:.1f} ms"
+                     f" | native `simulate` {fc['native'] * 1e3:.1f} ms | {fc['ratio']:.2f}x | "
                      "<= 1.5x |")
+        if "fmu_cs_fmpy_loop" in fc:
+            lines.append(f"| robot CS FMU, fmpy `FMU2Slave` loop (no unzip/XML), 10 s | "
+                         f"{fc['fmu_cs_fmpy_loop'] * 1e3:.1f} ms | native `simulate` "
+                         f"{fc['native'] * 1e3:.1f} ms | {fc['ratio_loop']:.2f}x | |")
     mc = report.get("cosim")
     if mc and mc.get("fmucontainer_s_per_s"):
         lines.append(f"| co-simulation master, robot split, 1 ms (Jacobi) | "
