@@ -83,7 +83,10 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
     final = []
     for i in keep_idx:
         v = new_vars[i]
-        final.append(replace(v, der=remap.get(v.der, -1), der_of=remap.get(v.der_of, -1)))
+        if v.der < 0 and v.der_of < 0:
+            final.append(v)                        # no derivative links to renumber
+        else:
+            final.append(replace(v, der=remap.get(v.der, -1), der_of=remap.get(v.der_of, -1)))
     out = FlatModel(model.name, final, model.parameters, model.inputs, equations, aliases,
                     model.discretes, hybrid)
     out.initial_equations = initial if n_init else []
