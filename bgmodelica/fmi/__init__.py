@@ -22,8 +22,11 @@ MATLAB's ode15s and scipy's BDF), the family CVODES and IDAS use: one function e
 Newton iteration, a Jacobian (CasADi-generated) and a dense LU with partial pivoting reused
 over many steps.  The history is kept between communication steps when nothing changed, and a
 step may pass the communication point (the state there is interpolated), so short
-communication steps do not cut the solver's steps; new inputs restart it at order 1.  The
-paper's robot takes 855 steps in 10 s at tolerance 1e-6 (an order-4 SDIRK needed 9435).
+communication steps do not cut the solver's steps.  The paper's robot takes 855 steps in 10 s
+at tolerance 1e-6 (the order-4 SDIRK alone needed 9435).  New inputs (held over the step, a jump
+of the right-hand side) would force a restart at order 1 with many small steps, at every step
+of a co-simulation; such steps are taken by the 5-stage order-4 L-stable SDIRK of Hairer &
+Wanner instead (``bgm_sdirk.c``; one LU per step serves all stages), which needs no history.
 Tunable parameters ``solver.tolerance`` (default: the spec's ``tolerance``, 1e-6; the tighter of
 it and a tolerance passed by the importer is used) and ``solver.max_step`` (default: the
 experiment length) control it; inputs are held over each communication step.

@@ -6,10 +6,10 @@ The directory holds everything needed to rebuild the binary with any C99 compile
 * ``<id>_model.c/.h``: the CasADi-generated model functions (:mod:`bgmodelica.fmi.codegen`);
 * ``bgm_model_data.h/.c``: sizes, value-reference layout, start values, ranges, names,
   instantiation token (generated here);
-* the runtime from ``templates/``: ``bgm_core.[ch]``, ``bgm_solver.c`` and the FMI wrappers
-  ``fmi<v>_common.c``, ``fmi<v>_me.c``, ``fmi<v>_cs.c`` (all three are always compiled so every
-  function of the standard exists in the binary; an interface type that the modelDescription
-  does not declare refuses to instantiate);
+* the runtime from ``templates/``: ``bgm_core.[ch]``, ``bgm_solver.c``, ``bgm_sdirk.c`` and the
+  FMI wrappers ``fmi<v>_common.c``, ``fmi<v>_me.c``, ``fmi<v>_cs.c`` (all three are always
+  compiled so every function of the standard exists in the binary; an interface type that the
+  modelDescription does not declare refuses to instantiate);
 * hybrid models (events) add ``bgm_events.[ch]`` (the event runtime) and the generated
   ``bgm_hybrid_data.c`` (its tables, see :mod:`bgmodelica.fmi.hybrid`);
 * the official FMI headers of the version, copied from the ``fmpy`` package
@@ -29,7 +29,7 @@ from .variables import SOLVER_TOLERANCE_MAX, SOLVER_TOLERANCE_MIN, VariableTable
 
 TEMPLATES = Path(__file__).parent / "templates"
 
-RUNTIME_FILES = ("bgm_core.h", "bgm_core.c", "bgm_solver.c")
+RUNTIME_FILES = ("bgm_core.h", "bgm_core.c", "bgm_solver.c", "bgm_sdirk.c")
 HYBRID_FILES = ("bgm_events.h", "bgm_events.c")
 WRAPPER_FILES = {2: ("fmi2_common.c", "fmi2_me.c", "fmi2_cs.c"),
                  3: ("fmi3_common.c", "fmi3_me.c", "fmi3_cs.c")}

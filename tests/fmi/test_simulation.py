@@ -172,9 +172,10 @@ def test_cs_solver_steps_do_not_follow_the_communication_grid(build_fmu):
     assert rel_err(pos_fine[::100], exact) < CS_RTOL
 
 
-def test_cs_new_inputs_restart_the_solver(build_fmu):
-    """A piecewise-constant input changing at every communication point: the solver restarts
-    there (no history across the jump) and matches the zero-order-hold reference."""
+def test_cs_new_inputs_take_one_step_method(build_fmu):
+    """A piecewise-constant input changing at every communication point: no history straddles
+    a jump (those steps are one-step SDIRK4 steps, mostly one per communication step) and the
+    result matches the zero-order-hold reference."""
     signal = np.array([(0.0, 0.0), (10.0, 5.0)], dtype=[("time", np.float64),
                                                          ("force", np.float64)])
     fmu = build_fmu("osc", 3, "cs")
@@ -182,3 +183,6 @@ def test_cs_new_inputs_restart_the_solver(build_fmu):
             start_values={"solver.tolerance": 1e-9})
     ref = oscillator_zoh(r["time"], lambda t: 0.5 * t)
     assert rel_err(r["pos"], ref) < 1e-6
+    steps, _ = _solver_steps(build_fmu("osc", 2, "cs"), input=signal, output_interval=0.01,
+                             stop_time=2.0)
+    assert steps < 1.2 * 200, steps                # 200 communication steps

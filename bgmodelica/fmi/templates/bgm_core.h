@@ -73,6 +73,7 @@ enum {
 #define BGM_BDF_ROWS 8     /* differences 0..order+2 of the highest order, 5 */
 typedef struct {
     int valid;             /* the history continues (snap_time, x, p, tolerance) */
+    int snap_ok;           /* snap_* hold the end of the last completed step */
     int order;             /* current order 1..5 */
     int n_equal;           /* steps taken with the current order and step size */
     int jac_fresh;         /* jac was evaluated at the current step's predictor */
@@ -215,6 +216,10 @@ bgm_status bgm_event_indicators(bgm_inst *c, const char *fn, size_t ni);
 /* Co-Simulation */
 bgm_status bgm_do_step(bgm_inst *c, const char *fn, double t, double h);
 bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end);  /* bgm_solver.c */
+bgm_status bgm_sdirk_integrate(bgm_inst *c, const char *fn, double t_end); /* bgm_sdirk.c */
+int bgm_lu_factor(double *a, int *piv, int n);        /* row-major, partial pivoting */
+void bgm_lu_solve(const double *a, const int *piv, int n, double *b);
+double bgm_wnorm(const double *v, const double *sc, int n); /* RMS of v ./ sc */
 size_t bgm_solver_workspace(void);                                     /* doubles */
 
 /* FMU state */

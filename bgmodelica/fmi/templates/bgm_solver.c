@@ -15,9 +15,11 @@
  * Between DoStep calls the history is kept when nothing changed (time, states, inputs up to
  * rounding, parameters, tolerance): a step may then run past the communication point and the
  * state there is interpolated from D, so communication points do not cut the solver's steps.
- * New inputs or parameters, set states, an event or a Reset restart it at order 1 (inputs
- * are held over each communication step, so a new input is a discontinuity the history must
- * not straddle).  The history is part of the FMU state: a restored state repeats the same
+ * New inputs are a jump of the right-hand side (they are held over each communication step)
+ * that the history must not straddle: that step is taken by the one-step SDIRK4 of
+ * bgm_sdirk.c instead, which needs no history (a restart at order 1 would need many small
+ * steps, every step, in a co-simulation).  New parameters, set states, an event or a Reset
+ * restart the BDF at order 1.  The history is part of the FMU state: a restored state repeats the same
  * steps.  Hybrid models stop every step at the event or communication time instead (their
  * relations are checked over each step).
  */
@@ -51,14 +53,15 @@ static void init_coefficients(void) {
     coefficients_ready = 1;
 }
 
-/* workspace: LU and 9 vectors (the history itself is FMU state, bgm_core.h) */
+/* workspace: the BDF's LU and 9 vectors (its history is FMU state, bgm_core.h), or
+   SDIRK4's 13 vectors and two matrices (bgm_sdirk.c); the two never run at once */
 size_t bgm_solver_workspace(void) {
     size_t n = BGM_NXA;
-    return 9 * n + n * n;
+    return 13 * n + 2 * n * n;
 }
 
 /* LU factorisation with partial pivoting of the row-major n x n matrix a (in place). */
-static int lu_factor(double *a, int *piv, int n) {
+int bgm_lu_factor(double *a, int *piv, int n) {
     int i, j, k;
     for (k = 0; k < n; k++) {
         int p = k;
@@ -86,7 +89,7 @@ static int lu_factor(double *a, int *piv, int n) {
     return 0;
 }
 
-static void lu_solve(const double *a, const int *piv, int n, double *b) {
+void bgm_lu_solve(const double *a, const int *piv, int n, double *b) {
     int i, j;
     for (i = 0; i < n; i++) {
         double t;
@@ -104,7 +107,7 @@ static void lu_solve(const double *a, const int *piv, int n, double *b) {
 }
 
 /* root mean square of v ./ sc */
-static double wnorm(const double *v, const double *sc, int n) {
+double bgm_wnorm(const double *v, const double *sc, int n) {
     double s = 0.0;
     int i;
     for (i = 0; i < n; i++) {
@@ -175,6 +178,41 @@ static int nearly_same(const double *a, const double *b, size_t n) {
     return 1;
 }
 
+/* first step size at order 1 from (t0, y0) with y0' = f (Hairer, Norsett & Wanner I, II.4):
+   h0 from |y| / |y'|, h1 from an estimate of y''; the proposal (if any) caps it; -1 when the
+   model cannot be evaluated */
+static double initial_step(bgm_inst *c, double t0, const double *y0, const double *f,
+                           double rtol, double hmax, double *sc, double *tmp, double *dy) {
+    const int n = BGM_NX;
+    double h0, h1, h, d0, d1, d2;
+    int i;
+    for (i = 0; i < n; i++) sc[i] = rtol * bgm_x_nominal[i] + rtol * fabs(y0[i]);
+    d0 = bgm_wnorm(y0, sc, n);
+    d1 = bgm_wnorm(f, sc, n);
+    h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
+    if (h0 > hmax) h0 = hmax;
+    for (i = 0; i < n; i++) tmp[i] = y0[i] + h0 * f[i];
+    if (bgm_call_xdot(c, t0 + h0, tmp, dy)) return -1.0;
+    for (i = 0; i < n; i++) dy[i] = (dy[i] - f[i]) / h0;
+    d2 = bgm_wnorm(dy, sc, n);
+    h1 = (d1 <= 1e-15 && d2 <= 1e-15) ? (h0 * 1e-3 > 1e-6 ? h0 * 1e-3 : 1e-6)
+                                      : sqrt(0.01 / (d1 > d2 ? d1 : d2));
+    h = 100.0 * h0 < h1 ? 100.0 * h0 : h1;
+    if (c->v.h_next > 0.0 && c->v.h_next < h) h = c->v.h_next;
+    return h;
+}
+
+/* remember where this step ended: the next one continues from here unless things changed */
+static void keep_snapshot(bgm_inst *c, double rtol) {
+    bgm_bdf *b = &c->v.bdf;
+    b->snap_ok = 1;
+    b->snap_time = c->v.time;
+    b->snap_tol = rtol;
+    memcpy(b->snap_x, c->v.x, BGM_NX * sizeof(double));
+    if (BGM_NU > 0) memcpy(b->snap_u, c->v.u, BGM_NU * sizeof(double));
+    if (BGM_NP > 0) memcpy(b->snap_p, c->v.p, BGM_NP * sizeof(double));
+}
+
 bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
     const int n = BGM_NX;
     bgm_bdf *b = &c->v.bdf;
@@ -202,44 +240,42 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
     if (newton_tol < 10.0 * EPS / rtol) newton_tol = 10.0 * EPS / rtol;
     if (overshoot) t_bound = INFINITY; /* the same steps whatever the importer's stop time */
 
-    /* continue the history (a step may already have passed the communication point), or
-       restart at order 1 from (time, x) */
-    if (!(b->valid && c->v.h_next > 0.0 && fabs(b->snap_time - c->v.time) <= 1e-11 * (fabs(c->v.time) > 1.0 ? fabs(c->v.time) : 1.0) &&
-          b->snap_tol == rtol &&
-        same(b->snap_x, c->v.x, n) && same(b->snap_p, c->v.p, BGM_NP) &&
-        nearly_same(b->snap_u, c->v.u, BGM_NU) &&
-          b->t >= b->snap_time && b->t <= t_bound)) {
-        double t0 = c->v.time, h0, h1, d0, d1, d2, span = t_bound - t0;
-        b->valid = 0;
-        memcpy(y0, c->v.x, n * sizeof(double));
-        if (bgm_call_xdot(c, t0, y0, f)) goto eval_failed;
-        /* initial step (Hairer, Norsett & Wanner I, II.4): h0 from |y|/|y'|, h1 from y'' */
-        for (i = 0; i < n; i++) sc[i] = rtol * bgm_x_nominal[i] + rtol * fabs(y0[i]);
-        d0 = wnorm(y0, sc, n);
-        d1 = wnorm(f, sc, n);
-        h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
-        if (h0 > span) h0 = span;
-        if (h0 > hmax) h0 = hmax;
-        for (i = 0; i < n; i++) tmp[i] = y0[i] + h0 * f[i];
-        if (bgm_call_xdot(c, t0 + h0, tmp, dy)) goto eval_failed;
-        for (i = 0; i < n; i++) dy[i] = (dy[i] - f[i]) / h0;
-        d2 = wnorm(dy, sc, n);
-        h1 = (d1 <= 1e-15 && d2 <= 1e-15) ? (h0 * 1e-3 > 1e-6 ? h0 * 1e-3 : 1e-6)
-                                          : sqrt(0.01 / (d1 > d2 ? d1 : d2));
-        b->h = 100.0 * h0 < h1 ? 100.0 * h0 : h1;
-        if (c->v.h_next > 0.0 && c->v.h_next < b->h) b->h = c->v.h_next;
-        if (b->h > hmax) b->h = hmax;
-        if (b->h > span) b->h = span;
-        memcpy(D, y0, n * sizeof(double));
-        for (i = 0; i < n; i++) D[n + i] = f[i] * b->h;
-        for (i = 2 * n; i < BGM_BDF_ROWS * n; i++) D[i] = 0.0;
-        b->t = t0;
-        b->order = 1;
-        b->n_equal = 0;
-        c->lu_ok = 0;
-        if (bgm_call_jacx(c, t0, y0, J)) goto eval_failed;
-        b->jac_fresh = 1;
-        b->valid = 1;
+    /* continue the history (a step may already have passed the communication point); after
+       new inputs take this step with SDIRK4 (bgm_sdirk.c); otherwise restart at order 1 */
+    {
+        double tscale = fabs(c->v.time) > 1.0 ? fabs(c->v.time) : 1.0;
+        int at_snap = b->snap_ok && c->v.h_next > 0.0 && b->snap_tol == rtol &&
+                      fabs(b->snap_time - c->v.time) <= 1e-11 * tscale &&
+                      same(b->snap_x, c->v.x, n) && same(b->snap_p, c->v.p, BGM_NP);
+        int new_inputs = at_snap && !nearly_same(b->snap_u, c->v.u, BGM_NU);
+        if (new_inputs) {
+            bgm_status st = bgm_sdirk_integrate(c, fn, t_end);
+            b->valid = 0;
+            c->lu_ok = 0;  /* SDIRK4 used the workspace */
+            b->snap_ok = st == BGM_OK && c->v.time == t_end;
+            if (b->snap_ok) keep_snapshot(c, rtol);
+            return st;
+        }
+        if (!(at_snap && b->valid && b->t >= b->snap_time && b->t <= t_bound)) {
+            double t0 = c->v.time;
+            b->valid = 0;
+            b->snap_ok = 0;
+            memcpy(y0, c->v.x, n * sizeof(double));
+            if (bgm_call_xdot(c, t0, y0, f)) goto eval_failed;
+            b->h = initial_step(c, t0, y0, f, rtol, hmax, sc, tmp, dy);
+            if (b->h < 0.0) goto eval_failed;
+            if (b->h > hmax) b->h = hmax;
+            if (bgm_call_jacx(c, t0, y0, J)) goto eval_failed;
+            b->jac_fresh = 1;
+            memcpy(D, y0, n * sizeof(double));
+            for (i = 0; i < n; i++) D[n + i] = f[i] * b->h;
+            for (i = 2 * n; i < BGM_BDF_ROWS * n; i++) D[i] = 0.0;
+            b->t = t0;
+            b->order = 1;
+            b->n_equal = 0;
+            c->lu_ok = 0;
+            b->valid = 1;
+        }
     }
 
     /* (a remainder of a few ulps of t_end is interpolated, not stepped) */
@@ -295,7 +331,7 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
                 for (i = 0; i < n; i++)
                     for (j = 0; j < n; j++)
                         LU[i * n + j] = (i == j ? 1.0 : 0.0) - c_coef * J[i + j * n];
-                if (lu_factor(LU, c->piv, n)) {
+                if (bgm_lu_factor(LU, c->piv, n)) {
                     c->lu_ok = 0;
                     why = "singular iteration matrix";
                     if (fresh) break;
@@ -318,8 +354,8 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
                     break;
                 }
                 for (i = 0; i < n; i++) dy[i] = c_coef * f[i] - psi[i] - d[i];
-                lu_solve(LU, c->piv, n, dy);
-                dy_norm = wnorm(dy, sc, n);
+                bgm_lu_solve(LU, c->piv, n, dy);
+                dy_norm = bgm_wnorm(dy, sc, n);
                 if (!isfinite(dy_norm)) {
                     why = "Newton iteration diverged";
                     break;
@@ -361,7 +397,7 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
         /* local error estimate */
         for (i = 0; i < n; i++) sc[i] = rtol * bgm_x_nominal[i] + rtol * fabs(ynew[i]);
         for (i = 0; i < n; i++) tmp[i] = ERRC[order] * d[i];
-        err_norm = wnorm(tmp, sc, n);
+        err_norm = bgm_wnorm(tmp, sc, n);
         safety = 0.9 * (2 * NEWTON_MAXITER + 1) / (2 * NEWTON_MAXITER + n_iter);
         if (!(err_norm <= 1.0)) {
             double factor = isfinite(err_norm) ? safety * pow(err_norm, -1.0 / (order + 1))
@@ -397,6 +433,7 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
                 memcpy(c->v.x, D, n * sizeof(double));
                 c->v.h_next = b->h;
                 b->valid = 0;
+                b->snap_ok = 0;
                 c->cache_valid = 0;
                 return BGM_OK;
             }
@@ -415,11 +452,11 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
             double em = INFINITY, ep = INFINITY, fm, f0, fp, factor;
             if (order > 1) {
                 for (i = 0; i < n; i++) tmp[i] = ERRC[order - 1] * D[order * n + i];
-                em = wnorm(tmp, sc, n);
+                em = bgm_wnorm(tmp, sc, n);
             }
             if (order < MAX_ORDER) {
                 for (i = 0; i < n; i++) tmp[i] = ERRC[order + 1] * D[(order + 2) * n + i];
-                ep = wnorm(tmp, sc, n);
+                ep = bgm_wnorm(tmp, sc, n);
             }
             fm = em > 0.0 ? pow(em, -1.0 / order) : INFINITY;
             f0 = err_norm > 0.0 ? pow(err_norm, -1.0 / (order + 1)) : INFINITY;
@@ -451,11 +488,7 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
     c->v.time = t_end;
     c->v.h_next = b->h;
     c->cache_valid = 0;
-    b->snap_time = t_end;
-    b->snap_tol = rtol;
-    memcpy(b->snap_x, c->v.x, n * sizeof(double));
-    if (BGM_NU > 0) memcpy(b->snap_u, c->v.u, BGM_NU * sizeof(double));
-    if (BGM_NP > 0) memcpy(b->snap_p, c->v.p, BGM_NP * sizeof(double));
+    keep_snapshot(c, rtol);
     bgm_log(c, BGM_OK, "logSolver", "%s: reached t=%g (solver at t=%g, order %d, step %g), "
             "%ld steps so far", fn, t_end, b->t, b->order, b->h, c->stat_steps);
     return BGM_OK;
@@ -465,6 +498,7 @@ eval_failed:
               "Jacobian); check inputs and parameters", fn, b->t);
 fail:
     b->valid = 0;
+    b->snap_ok = 0;
     c->cache_valid = 0;
     return BGM_ERROR;
 }
