@@ -219,7 +219,7 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
     double *D = b->d, *J = b->jac, *LU = c->ws, *ypred = LU + BGM_NXA * BGM_NXA;
     double *psi = ypred + BGM_NXA, *d = psi + BGM_NXA, *ynew = d + BGM_NXA, *f = ynew + BGM_NXA;
     double *dy = f + BGM_NXA, *sc = dy + BGM_NXA, *tmp = sc + BGM_NXA, *y0 = tmp + BGM_NXA;
-    double rtol = c->v.solver_tol, hmax = c->v.solver_hmax, newton_tol, t_bound = t_end;
+    double rtol = c->v.solver_tol, hmax = c->v.solver_hmax, newton_tol, t_bound;
     long substeps = 0;
 #if BGM_HYBRID
     const int overshoot = 0;
@@ -238,7 +238,8 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
     }
     newton_tol = sqrt(rtol) < 0.03 ? sqrt(rtol) : 0.03;
     if (newton_tol < 10.0 * EPS / rtol) newton_tol = 10.0 * EPS / rtol;
-    if (overshoot) t_bound = INFINITY; /* the same steps whatever the importer's stop time */
+    /* steps may pass t_end (not in hybrid models), whatever the importer's stop time */
+    t_bound = overshoot ? INFINITY : t_end;
 
     /* continue the history (a step may already have passed the communication point); after
        new inputs take this step with SDIRK4 (bgm_sdirk.c); otherwise restart at order 1 */
