@@ -18,6 +18,7 @@
 
 static int n_errors_logged = 0;
 static double dt = 0.01; /* communication step */
+static long vr_input = -1;  /* an input to change before every step (-1: none) */
 
 #define LOAD(name)                                                             \
     name##TYPE *name = (name##TYPE *)dlsym(lib, #name);                        \
@@ -90,7 +91,14 @@ static int run(void *lib, const char *token, unsigned vr_param, unsigned vr_out)
     CHECK(fmi2SerializeFMUstate(c, state, blob, size) == fmi2OK);
     CHECK(fmi2DeSerializeFMUstate(c, blob, size, &copy) == fmi2OK);
     free(blob);
-    for (k = 20; k < 30; k++) CHECK(fmi2DoStep(c, dt * k, dt, 1) == fmi2OK);
+    for (k = 20; k < 30; k++) {
+        if (vr_input >= 0) { /* new inputs at every step: the solver's one-step path */
+            fmi2ValueReference vr_in = (fmi2ValueReference)vr_input;
+            value = 10.0 + k;
+            CHECK(fmi2SetReal(c, &vr_in, 1, &value) == fmi2OK);
+        }
+        CHECK(fmi2DoStep(c, dt * k, dt, 1) == fmi2OK);
+    }
     CHECK(fmi2GetReal(c, &vr_out, 1, &y) == fmi2OK);
     CHECK(fmi2SetFMUstate(c, copy) == fmi2OK);
     CHECK(fmi2GetDirectionalDerivative(c, &vr_out, 1, &vr_param, 1, &seed, &dd) == fmi2OK);
@@ -153,8 +161,14 @@ static int run(void *lib, const char *token, unsigned vr_param, unsigned vr_out)
     CHECK(fmi3SerializeFMUState(c, state, blob, size) == fmi3OK);
     CHECK(fmi3DeserializeFMUState(c, blob, size, &copy) == fmi3OK);
     free(blob);
-    for (k = 20; k < 30; k++)
+    for (k = 20; k < 30; k++) {
+        if (vr_input >= 0) { /* new inputs at every step: the solver's one-step path */
+            fmi3ValueReference vr_in = (fmi3ValueReference)vr_input;
+            value = 10.0 + k;
+            CHECK(fmi3SetFloat64(c, &vr_in, 1, &value, 1) == fmi3OK);
+        }
         CHECK(fmi3DoStep(c, dt * k, dt, 1, &ev, &term, &early, &last) == fmi3OK);
+    }
     CHECK(fmi3GetFloat64(c, &vr_out, 1, &y, 1) == fmi3OK);
     CHECK(fmi3SetFMUState(c, copy) == fmi3OK);
     CHECK(fmi3GetDirectionalDerivative(c, &vr_out, 1, &vr_param, 1, &seed, 1, &dd, 1) ==
@@ -171,6 +185,8 @@ static int run(void *lib, const char *token, unsigned vr_param, unsigned vr_out)
 int main(int argc, char **argv) {
     void *lib;
     int round, rc = 0;
+    const char *input = getenv("BGM_DRIVER_INPUT_VR"); /* an input set before every step */
+    if (input) vr_input = atol(input);
     if (argc != 5 && argc != 6) {
         fprintf(stderr, "usage: %s lib.so token vr_param vr_output [step]\n", argv[0]);
         return 2;
