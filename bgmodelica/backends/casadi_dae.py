@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
-from ..core.flatmodel import FlatVariable, HybridPart
+from ..core.flatmodel import FlatVariable, HybridPart, take
 from ..core.variables import TIME
 from ..errors import ParameterError, UnitError
 from ..passes.sorting import SortedDAE
@@ -145,19 +145,18 @@ def build_dae(sorted_dae: SortedDAE) -> CasadiDAE:
     free_params = [p for p in model.parameters if not isinstance(p.decl.value, ca.SX)]
     bound = [p for p in model.parameters if isinstance(p.decl.value, ca.SX)]
 
-    vsym = [variables[j].sx for j, _ in sorted_dae.assignments]
-    vdef = [d for _, d in sorted_dae.assignments]
+    # columns are taken from the model's stacked symbols: no scalar restacking
+    column = model.stacked_variables()
+    assigned = [j for j, _ in sorted_dae.assignments]
     # what we need in terms of knowns: state derivatives, residuals, every variable
-    ode_raw = []
-    for j in states:
-        d = variables[j].der
-        ode_raw.append(variables[d].sx)
-    obs_raw = [v.sx for v in variables]
     hybrid = model.hybrid
     extra = hybrid.expressions() if hybrid is not None else []
-    targets = ca.vertcat(*(ode_raw + list(sorted_dae.residuals) + obs_raw + extra))
-    if vsym:
-        _, (targets,) = ca.substitute_inplace([ca.vertcat(*vsym)], [ca.vertcat(*vdef)],
+    targets = ca.vertcat(take(column, [variables[j].der for j in states]),
+                         *sorted_dae.residuals, column, *extra)
+    n_obs = len(variables)
+    if assigned:
+        _, (targets,) = ca.substitute_inplace([take(column, assigned)],
+                                              [sorted_dae.stacked_definitions()],
                                               [targets], False)
     if bound:
         bsym = ca.vertcat(*[p.sx for p in bound])
@@ -168,7 +167,6 @@ def build_dae(sorted_dae: SortedDAE) -> CasadiDAE:
         targets = ca.cse(targets)
     ode = targets[:n_x]
     alg = targets[n_x:n_x + n_r]
-    n_obs = len(obs_raw)
     observed = targets[n_x + n_r:n_x + n_r + n_obs]
     if hybrid is not None:
         rest = targets[n_x + n_r + n_obs:]
@@ -187,8 +185,8 @@ def build_dae(sorted_dae: SortedDAE) -> CasadiDAE:
     p = ca.vertcat(*[q.sx for q in free_params], *[u.sx for u in model.inputs],
                    *[d.sx for d in model.discretes])
     return CasadiDAE(
-        x=ca.vertcat(*[variables[j].sx for j in states]),
-        z=ca.vertcat(*[variables[j].sx for j in alg_vars]),
+        x=take(column, list(states)),
+        z=take(column, list(alg_vars)),
         p=p if p.numel() else ca.SX(0, 1), t=TIME.sx, ode=ode, alg=alg, observed=observed,
         names=names, state_names=[variables[j].name for j in states],
         algebraic_names=[variables[j].name for j in alg_vars],

@@ -108,6 +108,35 @@ class FlatModel:
     #: :attr:`bgmodelica.backends.casadi_dae.CasadiDAE.initial` by the compiler
     initial_equations: list[FlatEquation] = field(default_factory=list)
 
+    def stacked_residuals(self) -> ca.SX:
+        """Every equation's residual in one SX column, built once while :attr:`equations`
+        is the same list (stacking costs a few microseconds per scalar; the passes reuse it)."""
+        return self._stacked("_residual_column", self.equations,
+                             lambda: [e.residual for e in self.equations])
+
+    def stacked_variables(self) -> ca.SX:
+        """Every variable's symbol in one SX column (memoized like
+        :meth:`stacked_residuals`); ``take(model.stacked_variables(), idx)`` selects some."""
+        return self._stacked("_variable_column", self.variables,
+                             lambda: [v.sx for v in self.variables])
+
+    def remember_stacked(self, residuals: ca.SX | None = None,
+                         variables: ca.SX | None = None) -> None:
+        """Record columns a pass already holds (same order as the lists) for the
+        ``stacked_*`` methods."""
+        for key, items, col in (("_residual_column", self.equations, residuals),
+                                ("_variable_column", self.variables, variables)):
+            if col is not None and col.numel() == len(items):
+                self.__dict__[key] = ((id(items), len(items)), col)
+
+    def _stacked(self, key: str, items: list, scalars) -> ca.SX:
+        tag = (id(items), len(items))
+        memo = self.__dict__.get(key)
+        if memo is None or memo[0] != tag:
+            memo = (tag, ca.vertcat(*scalars()) if items else ca.SX(0, 1))
+            self.__dict__[key] = memo
+        return memo[1]
+
     def index(self) -> dict[str, int]:
         """Name -> index in :attr:`variables`."""
         return {v.name: i for i, v in enumerate(self.variables)}
@@ -131,6 +160,12 @@ class FlatModel:
 
     def parameter_values(self) -> dict[str, object]:
         return {p.name: p.decl.value for p in self.parameters}
+
+
+def take(column: ca.SX, idx: list[int]) -> ca.SX:
+    """Elements ``idx`` of an SX column (an empty column for no indices): one C++ call
+    instead of stacking scalars again."""
+    return column[idx] if idx else ca.SX(0, 1)
 
 
 # -- the hybrid part: relations, when-clauses, clocks and tables (slots index ``discretes``) -----

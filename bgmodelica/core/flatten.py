@@ -22,7 +22,7 @@ from ..validate import check_binding, check_sx_binding, guarded_equations
 from . import flatten_hybrid
 from .component import Component, Connection, Connector, Element
 from .expr import HYBRID_NODES, Equation, Expr, Leaf, Number, lower_group, shape_of, to_sx
-from .flatmodel import EquationSources, FlatEquation, FlatModel, FlatVariable
+from .flatmodel import EquationSources, FlatEquation, FlatModel, FlatVariable, take
 from .variables import (
     KIND_FLOW,
     KIND_INPUT,
@@ -51,6 +51,7 @@ class _Flattener:
         self.var_of: dict[int, int] = {}         # id(Symbol) -> variable index
         self.pos: dict[int, int] = {}            # id(Symbol) -> position in self.all_sx
         self.equations: list[FlatEquation] = []
+        self.columns: list[ca.SX] = []            # the residuals of self.equations, stacked
         self.draft: flatten_hybrid.HybridDraft | None = None
         self.slot: dict[int, int] = {}            # id(Symbol) -> index in discretes
         self.full: dict[int, str] = {}            # id(Symbol) -> dotted name
@@ -92,9 +93,13 @@ class _Flattener:
         if self.draft is not None:
             hybrid = flatten_hybrid.lower(self.draft, lambda s: self.slot[id(s)],
                                           lambda s: self.full[id(s)])
-        return FlatModel(name, variables, parameters, inputs, self.equations,
+        flat = FlatModel(name, variables, parameters, inputs, self.equations,
                          discretes=discretes, hybrid=hybrid, sources=sources,
                          initial_equations=initial)
+        flat.remember_stacked(ca.vertcat(*self.columns) if self.columns else None,
+                              take(self.all_sx, [self.pos[id(sym)] for sym, target, _ in symbols
+                                                 if target is variables]))
+        return flat
 
     def _initial_equations(self) -> list[FlatEquation]:
         """Lower the components' ``initial_equations()`` (Modelica ``initial equation``) to
@@ -331,6 +336,7 @@ class _Flattener:
             parts = ca.vertsplit(totals) if len(pairs.sums) > 1 else [totals]
             for total, (syms, _, origin) in zip(parts, pairs.sums, strict=True):
                 self.equations.append(FlatEquation(total, origin, terms=len(syms)))
+            self.columns.append(totals)
         if not pairs.a:
             return
         ia = [self.pos[id(s)] for s in pairs.a]
@@ -340,6 +346,7 @@ class _Flattener:
             va, vb = self.var_of.get(id(pairs.a[k])), self.var_of.get(id(pairs.b[k]))
             alias = (va, vb, -pairs.coef[k]) if va is not None and vb is not None else None
             self.equations.append(FlatEquation(r, pairs.origin[k], alias))
+        self.columns.append(res)
 
     # -- component equations ---------------------------------------------------------------
     def _component_equations(self) -> None:
@@ -375,6 +382,7 @@ class _Flattener:
         if slow:
             self._check_slow(slow)
             self.equations.extend(FlatEquation(r, where) for r, where in slow)
+            self.columns.extend(r for r, _ in slow)
 
     def _lower(self, key, members) -> None:
         n_leaves = len(members[0][0])
@@ -403,6 +411,7 @@ class _Flattener:
         parts = ca.vertsplit(res) if len(members) > 1 else [res]
         for r, (_, _, where, eq) in zip(parts, members, strict=True):
             self.equations.append(FlatEquation(r, where, self._alias(eq)))
+        self.columns.append(res)
 
     def _alias(self, eq: Equation) -> tuple[int, int, float] | None:
         terms: list[tuple[float, Any]] = []

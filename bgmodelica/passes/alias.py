@@ -6,7 +6,7 @@ from dataclasses import replace
 
 import casadi as ca
 
-from ..core.flatmodel import FlatEquation, FlatModel, FlatVariable
+from ..core.flatmodel import FlatEquation, FlatModel, FlatVariable, take
 from ..core.variables import Variable, derivative_unit
 from ..errors import InitializationError
 from ..structure.alias import alias_classes
@@ -59,19 +59,22 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
             eliminated.add(d_old)
             below_old, below_new = d_old, d_new
 
-    kept = [eq for k, eq in enumerate(model.equations) if k not in used]
+    kept_idx = [k for k in range(len(model.equations)) if k not in used]
+    kept = [model.equations[k] for k in kept_idx]
     residuals: list[ca.SX] = []
+    kept_column = None
     hybrid = model.hybrid
     extra = hybrid.expressions() if hybrid is not None else []
     n_init = len(model.initial_equations)          # substituted like the model's equations
     extra = [eq.residual for eq in model.initial_equations] + extra
     if kept or extra:
-        targets = ca.vertcat(*[eq.residual for eq in kept], *extra)
+        targets = ca.vertcat(take(model.stacked_residuals(), kept_idx), *extra)
         if old:
             targets = ca.substitute(targets, ca.vertcat(*old),
                                     ca.vertcat(*new_rep) * ca.DM(new_sign))
         parts = ca.vertsplit(targets) if targets.numel() > 1 else [targets]
         residuals = parts[:len(kept)]
+        kept_column = targets[:len(kept)]
         initial = [FlatEquation(r, eq.origin) for r, eq in
                    zip(parts[len(kept):len(kept) + n_init], model.initial_equations, strict=True)]
         if hybrid is not None:
@@ -90,6 +93,8 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
     out = FlatModel(model.name, final, model.parameters, model.inputs, equations, aliases,
                     model.discretes, hybrid)
     out.initial_equations = initial if n_init else []
+    if kept_column is not None:
+        out.remember_stacked(residuals=kept_column)
     return out
 
 

@@ -96,6 +96,10 @@ def reduce_index(model: FlatModel | ReducedModel,
                                  long_rows(equations[n_old:]))
     aug = FlatModel(model.name, variables, model.parameters, model.inputs, equations,
                     model.aliases, model.discretes, model.hybrid)
+    aug.remember_stacked(      # the old columns, extended by what was added
+        ca.vertcat(model.stacked_residuals(), *[e.residual for e in equations[n_old:]]),
+        ca.vertcat(model.stacked_variables(),
+                   *[v.sx for v in variables[len(model.variables):]]))
     eq_derivative = (links + [-1] * (len(equations) - len(links))) if links \
         else [-1] * len(equations)
     for new, of in pant.new_equations:

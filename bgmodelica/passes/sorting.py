@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import casadi as ca
 
+from ..core.flatmodel import take
 from ..diagnose import singular_linear_block
 from ..errors import EquationError, UnbalancedModelError
 from ..structure import block_lower_triangular, maximum_matching, tear
@@ -48,6 +49,24 @@ class SortedDAE:
     residuals: list[ca.SX]
     blocks: list[BlockInfo]          # loops and nonlinear scalar blocks
     n_explicit: int = 0              # scalar blocks solved explicitly
+    #: the explicit solutions as one column, and each assignment's position in it (-1: the
+    #: expression is in ``assignments`` only); see :meth:`stacked_definitions`
+    solution_column: ca.SX | None = field(default=None, repr=False)
+    positions: list[int] = field(default_factory=list, repr=False)
+
+    def stacked_definitions(self) -> ca.SX:
+        """The assignments' expressions as one column, in evaluation order (taken from the
+        vectors they were solved in, instead of stacking a scalar per assignment)."""
+        if self.solution_column is None or len(self.positions) != len(self.assignments):
+            return ca.vertcat(*[d for _, d in self.assignments]) if self.assignments \
+                else ca.SX(0, 1)
+        loose = [k for k, p in enumerate(self.positions) if p < 0]
+        base = self.solution_column.numel()
+        pool = ca.vertcat(self.solution_column, *[self.assignments[k][1] for k in loose])
+        pos = list(self.positions)
+        for i, k in enumerate(loose):
+            pos[k] = base + i
+        return take(pool, pos)
 
     @property
     def model(self):
@@ -88,19 +107,25 @@ def sort_equations(reduced: ReducedModel) -> SortedDAE:
     out = SortedDAE(reduced, [], [], [], [])
     blocks = block_lower_triangular(eq_cols, len(unknowns), matching)
     scalar = [b for b in blocks if len(b.eqs) == 1]
-    solved = solve_scalar_blocks([res[b.eqs[0]] for b in scalar],
-                                 [sym[b.vars[0]] for b in scalar],
-                                 {k for k, b in enumerate(scalar)
-                                  if model.equations[b.eqs[0]].terms > LONG_ROW})
-    explicit = {id(b): expr for b, expr in zip(scalar, solved, strict=True)}
+    scalar_eqs = [b.eqs[0] for b in scalar]
+    solved, out.solution_column, position = solve_scalar_blocks(
+        [res[e] for e in scalar_eqs], [sym[b.vars[0]] for b in scalar],
+        {k for k, e in enumerate(scalar_eqs) if model.equations[e].terms > LONG_ROW},
+        take(model.stacked_residuals(), scalar_eqs),
+        take(model.stacked_variables(), [unknowns[b.vars[0]] for b in scalar]))
+    explicit = {id(b): k for k, b in enumerate(scalar)}
+    has_discrete = any(v.decl.kind == "discrete" for v in variables)
     var_hashes: set[int] = set()
     for block in blocks:
         eqs, cols = list(block.eqs), list(block.vars)
-        _check_discrete_loop(model, eqs, [unknowns[c] for c in cols], res)
+        if has_discrete:
+            _check_discrete_loop(model, eqs, [unknowns[c] for c in cols], res)
         if len(eqs) == 1:
-            expr = explicit[id(block)]
+            k = explicit[id(block)]
+            expr = solved[k]
             if expr is not None:
                 out.assignments.append((unknowns[cols[0]], expr))
+                out.positions.append(position[k])
                 out.n_explicit += 1
                 continue
             names = [variables[unknowns[cols[0]]].name]
@@ -200,3 +225,4 @@ def _loop(out: SortedDAE, eqs, cols, eq_cols, res, sym, unknowns, names, variabl
         out.residuals.extend(res[e] for e in torn.residual_eqs)
         out.blocks.append(BlockInfo(len(eqs), "nonlinear", names, tear_names))
     out.assignments.extend((unknowns[c], d) for c, d in causal)
+    out.positions.extend([-1] * (len(out.assignments) - len(out.positions)))

@@ -64,8 +64,14 @@ def model_incidence(model) -> list[list[int]]:
     memo = model.__dict__.get("_incidence_memo")
     if memo is not None and memo[0] == key:
         return memo[1]
-    rows = incidence([e.residual for e in model.equations], [v.sx for v in model.variables],
-                     long_rows(model.equations))
+    if not model.equations:
+        rows: list[list[int]] = []
+    elif not model.variables:
+        rows = [[] for _ in model.equations]
+    else:
+        rows = _incidence([e.residual for e in model.equations],
+                          [v.sx for v in model.variables], model.stacked_residuals(),
+                          model.stacked_variables(), long_rows(model.equations))
     model.__dict__["_incidence_memo"] = (key, rows)
     return rows
 
@@ -118,18 +124,25 @@ def solve_linear_block(residuals: Sequence[ca.SX], vars_: Sequence[ca.SX],
 
 
 def solve_scalar_blocks(residuals: Sequence[ca.SX], vars_: Sequence[ca.SX],
-                        long: set[int] | None = None) -> list[ca.SX | None]:
+                        long: set[int] | None = None, r_all: ca.SX | None = None,
+                        v_all: ca.SX | None = None) -> tuple[list[ca.SX | None], ca.SX,
+                                                             list[int]]:
     """Solve each ``residuals[k] = 0`` for ``vars_[k]`` where it is linear in it (else None);
-    ``long``: positions of long sums (see :func:`incidence`).
+    ``long``: positions of long sums (see :func:`incidence`); ``r_all``/``v_all``: the same
+    residuals and variables already stacked, if the caller has them.
 
     Vectorized: the pairs are colored so that no residual of a color depends on another
     variable of that color; then one Jacobian and one substitution per color give every
     coefficient ``a`` and remainder ``b`` (``r = a*v + b``), and ``v = -b/a``.
+
+    Returns the solutions, and the same as one column with each solution's position in it
+    (``-1`` where None), so that callers can restack them without a scalar per element.
     """
     n = len(residuals)
     if n == 0:
-        return []
-    r_all, v_all = ca.vertcat(*residuals), ca.vertcat(*vars_)
+        return [], ca.SX(0, 1), []
+    r_all = ca.vertcat(*residuals) if r_all is None else r_all
+    v_all = ca.vertcat(*vars_) if v_all is None else v_all
     neighbours: list[set[int]] = [set() for _ in range(n)]
     for i, row in enumerate(_incidence(residuals, vars_, r_all, v_all, long)):
         for j in row:
@@ -144,18 +157,24 @@ def solve_scalar_blocks(residuals: Sequence[ca.SX], vars_: Sequence[ca.SX],
             c += 1
         color[k] = c
     out: list[ca.SX | None] = [None] * n
+    position = [-1] * n
     by_color: list[list[int]] = [[] for _ in range(max(color) + 1)]
     for k, c in enumerate(color):
         by_color[c].append(k)
+    columns, offset = [], 0
     for members in by_color:
         r = r_all[members]
         v = v_all[members]
         a = ca.jtimes(r, v, ca.DM.ones(len(members)))      # diagonal: no cross terms
         nonlinear = set(ca.jacobian_sparsity(a, v).get_triplet()[0])
         b = ca.substitute(r, v, ca.DM.zeros(len(members)))
-        sol = ca.vertsplit(-b / a) if len(members) > 1 else [-b / a]
-        a_parts = ca.vertsplit(a) if len(members) > 1 else [a]
+        column = -b / a
+        sol = ca.vertsplit(column) if len(members) > 1 else [column]
+        nonzero = set(ca.sparsify(a).sparsity().row())    # a = 0: not solvable for v
         for m, k in enumerate(members):
-            if m not in nonlinear and not a_parts[m].is_zero():
+            if m not in nonlinear and m in nonzero:
                 out[k] = sol[m]
-    return out
+                position[k] = offset + m
+        columns.append(column)
+        offset += len(members)
+    return out, ca.vertcat(*columns), position

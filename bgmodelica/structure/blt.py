@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from . import compiled
 from .diagnosis import check_structurally_nonsingular
 from .graph import gc_paused
 from .matching import Matching
@@ -33,11 +34,16 @@ def block_lower_triangular(
     perfect; if missing or not perfect one is computed, raising
     :class:`~bgmodelica.structure.errors.StructurallySingular` if none exists. A block depends
     only on the unknowns of itself and of earlier blocks; within a block, equations are sorted.
+    From :data:`~.compiled.LARGE` equations on the order is found by compiled code.
     """
     n = len(eq_vars)
     if matching is None or matching.size != n or n != n_unknowns:
         matching = check_structurally_nonsingular(eq_vars, n_unknowns, matching)
     var_to_eq, eq_to_var = matching.var_to_eq, matching.eq_to_var
+    if n >= compiled.LARGE:
+        groups = compiled.compiled_blocks(eq_vars, var_to_eq)
+        if groups is not None:
+            return [Block(g, [eq_to_var[e] for e in g]) for g in groups]
 
     index = [-1] * n
     low = [0] * n

@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from . import compiled
 from .graph import gc_paused
 
 _INF = 1 << 60
@@ -175,8 +176,11 @@ def maximum_matching(
     Only variables with ``var_allowed[j]`` and equations with ``eq_allowed[i]`` take part
     (all by default). ``initial`` warm-starts the search: its pairs whose edge exists and whose
     ends are allowed are kept, the rest dropped; it may be shorter than the current graph.
+    Without ``initial``, from :data:`~.compiled.LARGE` equations on, compiled code searches.
     """
     adj = _filtered_adjacency(eq_vars, var_allowed, eq_allowed)
+    if initial is None and len(adj) >= compiled.LARGE:
+        return Matching(*compiled.compiled_matching(adj, n_vars))
     if initial is None:
         eq_to_var = [-1] * len(adj)
         var_to_eq = [-1] * n_vars

@@ -203,3 +203,17 @@ def test_declare_adds_an_instance_array_and_refuses_a_second_one():
         m.declare("x", Variable())
     res = bg.simulate(m, stop_time=1.0, interval=0.5, **TIGHT)
     assert res["x[4]"][-1] == pytest.approx(4.0 * np.exp(-2.0), rel=1e-8)
+
+
+@pytest.mark.parametrize("n", [2, 9])
+def test_ladder_forms_agree_with_the_compiled_graph_searches(n, monkeypatch):
+    """Large systems are matched and BLT-ordered by scipy's compiled searches; forcing them
+    on small ladders gives the same solutions as the Python algorithms."""
+    from bgmodelica.structure import compiled
+
+    ref = bg.simulate(RCLadder(n), stop_time=0.5, interval=0.05, **TIGHT)
+    monkeypatch.setattr(compiled, "LARGE", 1)
+    for M, name in ((RCLadder, f"C{n}.v"), (RCLadderArrays, f"C[{n}].v"),
+                    (RCLadderVector, f"v[{n}]")):
+        res = bg.simulate(M(n), stop_time=0.5, interval=0.05, **TIGHT)
+        assert np.max(np.abs(res[name] - ref[f"C{n}.v"])) < 1e-10
