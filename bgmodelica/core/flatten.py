@@ -409,8 +409,15 @@ class _Flattener:
         rhs = lower_group(shape_r, leaf_vecs[n_l:], const_vecs[c_l:])
         res = ca.SX(lhs - rhs)
         parts = ca.vertsplit(res) if len(members) > 1 else [res]
-        for r, (_, _, where, eq) in zip(parts, members, strict=True):
-            self.equations.append(FlatEquation(r, where, self._alias(eq)))
+        signs = _alias_signs(shape_l, shape_r)
+        for r, (leaves, _, where, eq) in zip(parts, members, strict=True):
+            if signs is None:
+                alias = self._alias(eq)
+            elif signs:
+                alias = self._alias_of(signs[0], leaves[0], signs[1], leaves[1])
+            else:
+                alias = None
+            self.equations.append(FlatEquation(r, where, alias))
         self.columns.append(res)
 
     def _alias(self, eq: Equation) -> tuple[int, int, float] | None:
@@ -420,6 +427,10 @@ class _Flattener:
         if len(terms) != 2:
             return None
         (sa, a), (sb, b) = terms
+        return self._alias_of(sa, a, sb, b)
+
+    def _alias_of(self, sa: float, a: Any, sb: float, b: Any) -> tuple[int, int, float] | None:
+        """``sa*a + sb*b = 0`` as the alias link ``a = -sb/sa * b``, if both are variables."""
         ia, ib = self.var_of.get(id(a)), self.var_of.get(id(b))
         if ia is None or ib is None or ia == ib or a.der_of is not None or b.der_of is not None:
             return None
@@ -489,6 +500,39 @@ def _count_consts(shape: Any) -> int:
     if shape == "L":
         return 0
     return sum(_count_consts(a) for a in shape[1:])
+
+
+def _alias_signs(shape_l: Any, shape_r: Any) -> tuple[float, float] | tuple[()] | None:
+    """For an equation shape ``lhs == rhs``: the signs of its two leaves if every equation
+    of that shape is ``sa*a + sb*b = 0`` (sums and negations of two leaves), ``()`` if none
+    is, None if it depends on the constants (decided equation by equation)."""
+    signs: list[float] = []
+
+    def walk(s: Any, sign: float) -> bool | None:
+        if s == "L":
+            signs.append(sign)
+            return len(signs) <= 2
+        if s == "C":
+            return None
+        if s[0] == "neg":
+            return walk(s[1], -sign)
+        if s[0] in ("+", "-"):
+            first = walk(s[1], sign)
+            if first is False:
+                return False
+            second = walk(s[2], sign if s[0] == "+" else -sign)
+            if second is False:
+                return False
+            return None if first is None or second is None else True
+        return False
+
+    left = walk(shape_l, 1.0)
+    right = walk(shape_r, -1.0) if left is not False else False
+    if left is False or right is False:
+        return ()
+    if left is None or right is None:
+        return None
+    return (signs[0], signs[1]) if len(signs) == 2 else ()
 
 
 def _signed_leaves(e: Any, sign: float, out: list) -> bool:

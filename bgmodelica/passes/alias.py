@@ -23,18 +23,23 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
     if not links:
         return model
 
+    ranks: dict[int, tuple] = {}
+
     def rank(i: int) -> tuple:
-        v = variables[i]
-        return (v.der >= 0, v.state_select, bool(getattr(v.decl, "fixed", False)),
-                -v.name.count("."), -len(v.name))
+        got = ranks.get(i)
+        if got is None:
+            v = variables[i]
+            got = ranks[i] = (v.der >= 0, v.state_select, bool(getattr(v.decl, "fixed", False)),
+                              -v.name.count("."), -len(v.name))
+        return got
 
     classes = alias_classes(len(variables), links, lambda a, b: rank(a) > rank(b))
     used = set(link_eqs) - {link_eqs[k] for k in classes.redundant}
 
     new_vars = list(variables)
     _merge_metadata(new_vars, classes.rep, classes.sign)
-    old: list[ca.SX] = []
-    new_rep: list[ca.SX] = []
+    old: list[int] = []              # indices in new_vars (which extends variables)
+    new_rep: list[int] = []
     new_sign: list[float] = []
     eliminated: set[int] = set()
     aliases = dict(model.aliases)
@@ -43,8 +48,8 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
         if r == i:
             continue
         s = classes.sign[i]
-        old.append(v.sx)
-        new_rep.append(variables[r].sx)
+        old.append(i)
+        new_rep.append(r)
         new_sign.append(s)
         eliminated.add(i)
         aliases[v.name] = (variables[r].name, s)
@@ -52,13 +57,15 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
         while variables[below_old].der >= 0:       # der(v) = s * der(r), der(der(v)) = ...
             d_old = variables[below_old].der
             d_new = _ensure_derivative(new_vars, below_new)
-            old.append(variables[d_old].sx)
-            new_rep.append(new_vars[d_new].sx)
+            old.append(d_old)
+            new_rep.append(d_new)
             new_sign.append(s)
             aliases[variables[d_old].name] = (new_vars[d_new].name, s)
             eliminated.add(d_old)
             below_old, below_new = d_old, d_new
 
+    column = ca.vertcat(model.stacked_variables(),     # symbols of new_vars, by index
+                        *[v.sx for v in new_vars[len(variables):]])
     kept_idx = [k for k in range(len(model.equations)) if k not in used]
     kept = [model.equations[k] for k in kept_idx]
     residuals: list[ca.SX] = []
@@ -70,8 +77,8 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
     if kept or extra:
         targets = ca.vertcat(take(model.stacked_residuals(), kept_idx), *extra)
         if old:
-            targets = ca.substitute(targets, ca.vertcat(*old),
-                                    ca.vertcat(*new_rep) * ca.DM(new_sign))
+            targets = ca.substitute(targets, take(column, old),
+                                    take(column, new_rep) * ca.DM(new_sign))
         parts = ca.vertsplit(targets) if targets.numel() > 1 else [targets]
         residuals = parts[:len(kept)]
         kept_column = targets[:len(kept)]
@@ -93,8 +100,7 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
     out = FlatModel(model.name, final, model.parameters, model.inputs, equations, aliases,
                     model.discretes, hybrid)
     out.initial_equations = initial if n_init else []
-    if kept_column is not None:
-        out.remember_stacked(residuals=kept_column)
+    out.remember_stacked(residuals=kept_column, variables=take(column, keep_idx))
     return out
 
 
