@@ -44,6 +44,7 @@ class _Flattener:
     def __init__(self, top: Component) -> None:
         self.top = top
         self.paths: dict[int, str] = {}          # id(element) -> dotted path
+        self.origins: dict[int, str] = {}        # id(element) -> "path (Class)"
         self.parents: dict[int, Element] = {}    # id(element) -> parent element
         self.elements: list[Element] = []
         self.pending: list[tuple[Any, Component]] = []   # raw equations with context
@@ -156,7 +157,12 @@ class _Flattener:
         return EquationSources(self.groups, self.draft, bindings, links, self.initial_sources)
 
     def where(self, elem: Element) -> str:
-        return f"{self.paths[id(elem)] or 'top level'} ({type(elem).__name__})"
+        """``path (Class)`` of an element, for equation origins and messages."""
+        text = self.origins.get(id(elem))
+        if text is None:
+            text = self.origins[id(elem)] = \
+                f"{self.paths[id(elem)] or 'top level'} ({type(elem).__name__})"
+        return text
 
     # -- symbols ---------------------------------------------------------------------------
     def _collect_symbols(self):
@@ -410,24 +416,12 @@ class _Flattener:
         res = ca.SX(lhs - rhs)
         parts = ca.vertsplit(res) if len(members) > 1 else [res]
         signs = _alias_signs(shape_l, shape_r)
-        for r, (leaves, _, where, eq) in zip(parts, members, strict=True):
-            if signs is None:
-                alias = self._alias(eq)
-            elif signs:
+        for r, (leaves, consts, where, _) in zip(parts, members, strict=True):
+            alias = None
+            if signs and not any(consts):
                 alias = self._alias_of(signs[0], leaves[0], signs[1], leaves[1])
-            else:
-                alias = None
             self.equations.append(FlatEquation(r, where, alias))
         self.columns.append(res)
-
-    def _alias(self, eq: Equation) -> tuple[int, int, float] | None:
-        terms: list[tuple[float, Any]] = []
-        if not (_signed_leaves(eq.lhs, 1.0, terms) and _signed_leaves(eq.rhs, -1.0, terms)):
-            return None
-        if len(terms) != 2:
-            return None
-        (sa, a), (sb, b) = terms
-        return self._alias_of(sa, a, sb, b)
 
     def _alias_of(self, sa: float, a: Any, sb: float, b: Any) -> tuple[int, int, float] | None:
         """``sa*a + sb*b = 0`` as the alias link ``a = -sb/sa * b``, if both are variables."""
@@ -502,52 +496,27 @@ def _count_consts(shape: Any) -> int:
     return sum(_count_consts(a) for a in shape[1:])
 
 
-def _alias_signs(shape_l: Any, shape_r: Any) -> tuple[float, float] | tuple[()] | None:
-    """For an equation shape ``lhs == rhs``: the signs of its two leaves if every equation
-    of that shape is ``sa*a + sb*b = 0`` (sums and negations of two leaves), ``()`` if none
-    is, None if it depends on the constants (decided equation by equation)."""
+def _alias_signs(shape_l: Any, shape_r: Any) -> tuple[float, ...]:
+    """For an equation shape ``lhs == rhs`` made of sums and negations of two leaves and
+    constants: the signs ``(sa, sb)`` of the leaves (the equation is the alias link
+    ``sa*a + sb*b = 0`` when its constants are all 0); ``()`` for any other shape."""
     signs: list[float] = []
 
-    def walk(s: Any, sign: float) -> bool | None:
+    def walk(s: Any, sign: float) -> bool:
         if s == "L":
             signs.append(sign)
             return len(signs) <= 2
         if s == "C":
-            return None
+            return True
         if s[0] == "neg":
             return walk(s[1], -sign)
         if s[0] in ("+", "-"):
-            first = walk(s[1], sign)
-            if first is False:
-                return False
-            second = walk(s[2], sign if s[0] == "+" else -sign)
-            if second is False:
-                return False
-            return None if first is None or second is None else True
+            return walk(s[1], sign) and walk(s[2], sign if s[0] == "+" else -sign)
         return False
 
-    left = walk(shape_l, 1.0)
-    right = walk(shape_r, -1.0) if left is not False else False
-    if left is False or right is False:
-        return ()
-    if left is None or right is None:
-        return None
-    return (signs[0], signs[1]) if len(signs) == 2 else ()
-
-
-def _signed_leaves(e: Any, sign: float, out: list) -> bool:
-    """Collect ``(sign, symbol)`` of a sum of (negated) leaves; False for anything else."""
-    if isinstance(e, Leaf):
-        out.append((sign, e.sym))
-        return len(out) <= 2
-    if isinstance(e, float) or isinstance(e, Number):
-        return e == 0
-    if isinstance(e, Expr) and e.op in ("+", "-", "neg") and len(out) <= 2:
-        if e.op == "neg":
-            return _signed_leaves(e.args[0], -sign, out)
-        return (_signed_leaves(e.args[0], sign, out)
-                and _signed_leaves(e.args[1], sign if e.op == "+" else -sign, out))
-    return False
+    if walk(shape_l, 1.0) and walk(shape_r, -1.0) and len(signs) == 2:
+        return (signs[0], signs[1])
+    return ()
 
 
 def _leaf_symbols(e: Any) -> list:

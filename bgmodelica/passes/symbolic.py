@@ -38,10 +38,14 @@ def _incidence(residuals: Sequence[ca.SX], symbols: Sequence[ca.SX], stacked: ca
     long = {k for k in (long or ()) if k < len(residuals)}
     sym_vec = ca.vertcat(*symbols) if sym_vec is None else sym_vec
     if long:
-        column = {s.element_hash(): j for j, s in enumerate(symbols)}
-        for k in long:
-            rows[k] = sorted(column[s.element_hash()] for s in ca.symvar(residuals[k])
-                             if s.element_hash() in column)
+        ordered = sorted(long)                 # their own pass: few rows, one sweep each 64
+        expr = stacked[ordered] if stacked is not None \
+            else ca.vertcat(*[residuals[k] for k in ordered])
+        r, c = ca.jacobian_sparsity(expr, sym_vec).get_triplet()
+        for i, j in zip(r, c, strict=True):
+            rows[ordered[i]].append(j)
+        for k in ordered:
+            rows[k].sort()
         short = [k for k in range(len(residuals)) if k not in long]
         if not short:
             return rows
