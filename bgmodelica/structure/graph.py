@@ -7,6 +7,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
+import numpy as np
+
 
 @contextmanager
 def gc_paused() -> Iterator[None]:
@@ -126,15 +128,31 @@ class EquationGraph:
 
 
 def _inverse(links: list[int], n: int, what: str) -> list[int]:
-    inv = [-1] * n
-    for i, d in enumerate(links):
-        if d == -1:
-            continue
-        if not 0 <= d < n:
-            raise ValueError(f"{what} {i} has derivative {d} out of range")
-        if d == i or inv[d] != -1:
-            raise ValueError(f"{what} {d} is the derivative of more than one {what}")
-        inv[d] = i
+    return _inverse_array(np.asarray(links, dtype=np.int64), n, what).tolist()
+
+
+def _inverse_array(arr: np.ndarray, n: int, what: str) -> np.ndarray:
+    """``inv[d] = i`` for every link ``i -> d`` (numpy; the checks of :func:`_inverse`)."""
+    src = np.flatnonzero(arr != -1)
+    dst = arr[src]
+    bad = np.flatnonzero((dst < 0) | (dst >= n))
+    if bad.size:
+        i = int(src[bad[0]])
+        raise ValueError(f"{what} {i} has derivative {int(arr[i])} out of range")
+    clash = dst == src
+    counts = np.bincount(dst, minlength=n)
+    clash |= counts[dst] > 1
+    if clash.any():
+        k = np.flatnonzero(clash)
+        # report the first link (in order) that repeats a target or points to itself
+        first_seen = {}
+        for idx in k.tolist():
+            d = int(dst[idx])
+            if d == int(src[idx]) or d in first_seen:
+                raise ValueError(f"{what} {d} is the derivative of more than one {what}")
+            first_seen[d] = idx
+    inv = np.full(n, -1, dtype=np.int64)
+    inv[dst] = src
     return inv
 
 
@@ -142,21 +160,25 @@ def derivative_chains(links: list[int], what: str = "variable") -> tuple[
         list[int], list[int], list[int]]:
     """For derivative links (``links[j]`` = derivative of ``j`` or -1) return
     ``(integral, order, root)``: the inverse links, the derivative order and the order-0
-    ancestor of every element. Raises ``ValueError`` for non-injective or cyclic links."""
+    ancestor of every element. Raises ``ValueError`` for non-injective or cyclic links.
+    Vectorized over derivative orders (one numpy pass per order)."""
     n = len(links)
-    inv = _inverse(links, n, what)
-    order = [-1] * n
-    root = [-1] * n
-    seen = 0
-    for j in range(n):
-        if inv[j] == -1:
-            k, o = j, 0
-            while k != -1:
-                order[k] = o
-                root[k] = j
-                seen += 1
-                o += 1
-                k = links[k]
+    arr = np.asarray(links, dtype=np.int64)
+    inv = _inverse_array(arr, n, what)
+    order = np.full(n, -1, dtype=np.int64)
+    root = np.full(n, -1, dtype=np.int64)
+    level = np.flatnonzero(inv == -1)
+    order[level] = 0
+    root[level] = level
+    seen, o = level.size, 0
+    while level.size:
+        nxt = arr[level]
+        keep = nxt != -1
+        level, origin = nxt[keep], root[level[keep]]
+        o += 1
+        order[level] = o
+        root[level] = origin
+        seen += level.size
     if seen != n:
         raise ValueError(f"cyclic {what} derivative links")
-    return inv, order, root
+    return inv.tolist(), order.tolist(), root.tolist()
