@@ -34,6 +34,8 @@ from .expr import ArrayBase, Equation, Expr, Number
 def element_names(name: str, shape: tuple[int, ...]) -> list[str]:
     """Modelica names of the elements of an array ``name`` of ``shape``, in C order:
     ``x[1]``, ``x[2]``..., or ``A[1,1]``, ``A[1,2]``... for matrices."""
+    if len(shape) == 1:
+        return [f"{name}[{i}]" for i in range(1, shape[0] + 1)]
     return [f"{name}[{','.join(str(i + 1) for i in idx)}]" for idx in np.ndindex(*shape)]
 
 

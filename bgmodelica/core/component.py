@@ -144,7 +144,7 @@ class Element:
         mods = element_values(modifier, shape, where) if modifier is not None else None
         leaves = []
         for k, name in enumerate(element_names(key, shape)):
-            elem = replace(scalar, **{f: v[k] for f, v in per_field.items()}) if per_field \
+            elem = scalar.evolve(**{f: v[k] for f, v in per_field.items()}) if per_field \
                 else scalar
             if mods is not None:
                 elem = elem.with_start(mods[k])

@@ -57,6 +57,15 @@ class Declaration:
     def with_start(self, value: Any) -> Declaration:
         raise NotImplementedError
 
+    def evolve(self, **fields: Any) -> Declaration:
+        """A copy with ``fields`` (existing field names, plain values) changed: what
+        ``dataclasses.replace`` does, without re-running ``__init__`` (a large array
+        declares one copy per element)."""
+        new = object.__new__(type(self))
+        new.__dict__.update(self.__dict__)
+        new.__dict__.update(fields)
+        return new
+
 
 @dataclass(frozen=True)
 class Parameter(Declaration):
@@ -71,7 +80,7 @@ class Parameter(Declaration):
     kind = KIND_PARAMETER
 
     def with_start(self, value: Any) -> Parameter:
-        return replace(self, value=value)
+        return self.evolve(value=value)
 
 
 @dataclass(frozen=True)
@@ -98,7 +107,7 @@ class Variable(Declaration):
                 return replace(self, **value)
             except TypeError as err:
                 raise DeclarationError(f"bad modifier {value!r}: {err}") from None
-        return replace(self, start=value, fixed=True)
+        return self.evolve(start=value, fixed=True)
 
 
 @dataclass(frozen=True)

@@ -34,30 +34,29 @@ def incidence(residuals: Sequence[ca.SX], symbols: Sequence[ca.SX],
 def _incidence(residuals: Sequence[ca.SX], symbols: Sequence[ca.SX], stacked: ca.SX | None,
                sym_vec: ca.SX | None, long: set[int] | None) -> list[list[int]]:
     """:func:`incidence`, reusing the residuals and symbols already stacked when given."""
-    rows: list[list[int]] = [[] for _ in residuals]
     long = {k for k in (long or ()) if k < len(residuals)}
     sym_vec = ca.vertcat(*symbols) if sym_vec is None else sym_vec
-    if long:
-        ordered = sorted(long)                 # their own pass: few rows, one sweep each 64
-        expr = stacked[ordered] if stacked is not None \
-            else ca.vertcat(*[residuals[k] for k in ordered])
-        r, c = ca.jacobian_sparsity(expr, sym_vec).get_triplet()
-        for i, j in zip(r, c, strict=True):
-            rows[ordered[i]].append(j)
-        for k in ordered:
-            rows[k].sort()
-        short = [k for k in range(len(residuals)) if k not in long]
-        if not short:
-            return rows
-        expr = stacked[short] if stacked is not None \
-            else ca.vertcat(*[residuals[k] for k in short])
-    else:
-        short = range(len(residuals))
+    if not long:
         expr = stacked if stacked is not None else ca.vertcat(*residuals)
-    r, c = ca.jacobian_sparsity(expr, sym_vec).get_triplet()
-    for i, j in zip(r, c, strict=True):
-        rows[short[i]].append(j)
+        return _sparsity_rows(expr, sym_vec)
+    rows: list[list[int]] = [[] for _ in residuals]
+    ordered = sorted(long)                     # their own pass: few rows, one sweep each 64
+    short = [k for k in range(len(residuals)) if k not in long]
+    for part in (ordered, short):
+        if part:
+            expr = stacked[part] if stacked is not None \
+                else ca.vertcat(*[residuals[k] for k in part])
+            for k, row in zip(part, _sparsity_rows(expr, sym_vec), strict=True):
+                rows[k] = row
     return rows
+
+
+def _sparsity_rows(expr: ca.SX, sym_vec: ca.SX) -> list[list[int]]:
+    """Column indices (ascending) of every row of the Jacobian sparsity of ``expr``: the
+    transposed pattern's compressed columns, sliced (no loop over nonzeros)."""
+    pattern = ca.jacobian_sparsity(expr, sym_vec).T
+    cols, starts = pattern.row(), pattern.colind()
+    return [cols[a:b] for a, b in zip(starts[:-1], starts[1:], strict=True)]
 
 
 def model_incidence(model) -> list[list[int]]:
