@@ -217,3 +217,20 @@ def test_ladder_forms_agree_with_the_compiled_graph_searches(n, monkeypatch):
                     (RCLadderVector, f"v[{n}]")):
         res = bg.simulate(M(n), stop_time=0.5, interval=0.05, **TIGHT)
         assert np.max(np.abs(res[name] - ref[f"C{n}.v"])) < 1e-10
+
+
+def test_per_element_declarations_equal_dataclass_replace():
+    """Array elements get their declarations through ``Declaration.evolve`` (no __init__
+    per element): the same objects ``dataclasses.replace`` would build."""
+    from dataclasses import replace
+
+    base = Variable(unit="V", start=0.0, nominal=2.0)
+    copy = base.evolve(start=3.0, fixed=True)
+    assert copy == replace(base, start=3.0, fixed=True) and hash(copy) == hash(
+        replace(base, start=3.0, fixed=True))
+    assert base.start == 0.0 and not base.fixed and type(copy) is Variable
+    p = Parameter(1.0, unit="Ohm")
+    assert p.with_start(2.5) == replace(p, value=2.5)
+    m = RCLadderVector(3)
+    assert [m._symbols[f"R[{k}]"].decl.value for k in (1, 2, 3)] == [1.0, 0.5, 1.0 / 3]
+    assert [m._symbols[f"v[{k}]"].decl.start for k in (1, 2, 3)] == [1.0, 2.0, 3.0]
