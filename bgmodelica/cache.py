@@ -16,12 +16,14 @@ or ``~/.cache/bgmodelica``); ``cache="path"`` another folder; :func:`clear` empt
 
 from __future__ import annotations
 
+import copyreg
 import functools
 import hashlib
 import io
 import os
 import pickle
 import sys
+import threading
 from dataclasses import is_dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -241,32 +243,31 @@ def model_key(model: Component) -> str:
 # -- storing and loading --------------------------------------------------------------------
 
 class _Pickler(pickle.Pickler):
-    """Pickles a compiled model with its SX expressions set aside (stored together)."""
+    """Pickles a compiled model with its SX expressions set aside (stored together, one
+    CasADi serialization of their shared graph). SX objects are found through the
+    dispatch table (looked up in C per object type) rather than a per-object hook."""
 
     def __init__(self, f: Any) -> None:
         super().__init__(f, protocol=pickle.HIGHEST_PROTOCOL)
         self.sx: list[ca.SX] = []
-        self.ids: dict[int, int] = {}
+        self.dispatch_table = {**copyreg.dispatch_table, ca.SX: self._set_aside,
+                               ca.Function: _refuse, ca.MX: _refuse}
 
-    def persistent_id(self, obj: Any) -> Any:
-        if isinstance(obj, ca.SX):
-            k = id(obj)
-            if k not in self.ids:
-                self.ids[k] = len(self.sx)
-                self.sx.append(obj)
-            return ("sx", self.ids[k])
-        if isinstance(obj, (Element, ca.Function, ca.MX)):
-            raise Uncacheable(f"the compiled model refers to a {type(obj).__name__}")
-        return None
+    def _set_aside(self, obj: ca.SX) -> tuple:
+        self.sx.append(obj)                       # the pickle memo sees each object once
+        return (_stored_sx, (len(self.sx) - 1,))
 
 
-class _Unpickler(pickle.Unpickler):
-    def __init__(self, f: Any, sx: list[ca.SX]) -> None:
-        super().__init__(f)
-        self.sx = sx
+def _refuse(obj: Any) -> tuple:
+    raise Uncacheable(f"the compiled model refers to a {type(obj).__name__}")
 
-    def persistent_load(self, pid: Any) -> Any:
-        return self.sx[pid[1]]
+
+_LOADING = threading.local()
+
+
+def _stored_sx(index: int) -> ca.SX:
+    """The ``index``-th SX of the entry being loaded (see :func:`load`)."""
+    return _LOADING.sx[index]
 
 
 def _entry(folder: Path, key: str) -> Path:
@@ -307,8 +308,11 @@ def load(folder: Path, key: str, model: Component) -> Any | None:
         fmt, text, body = pickle.loads(path.read_bytes())
         if fmt != FORMAT:
             raise ValueError("format")
-        sx = ca.StringDeserializer(text).unpack()
-        compiled = _Unpickler(io.BytesIO(body), sx).load()
+        _LOADING.sx = ca.StringDeserializer(text).unpack()
+        try:
+            compiled = pickle.loads(body)
+        finally:
+            _LOADING.sx = None
     except Exception:  # noqa: BLE001 -- a damaged entry is recompiled, not an error
         path.unlink(missing_ok=True)
         return None

@@ -154,7 +154,8 @@ def _compile_cached(model: Component, units: str, cache: bool | str | Path) -> C
     folder = disk.default_dir() if cache is True else Path(cache)
     t0 = _time.perf_counter()
     try:
-        key = disk.model_key(model) + f"-{units}"
+        with gc_paused():
+            key = disk.model_key(model) + f"-{units}"
     except disk.Uncacheable:
         key = None
     if key is not None:

@@ -85,6 +85,10 @@ class EquationSources:
     initial: list[tuple[Any, str]] = field(default_factory=list)
 
 
+#: per-model memos kept in ``FlatModel.__dict__`` (not pickled)
+_MEMOS = frozenset({"_residual_column", "_variable_column", "_incidence_memo"})
+
+
 @dataclass
 class FlatModel:
     """Variables, parameters, inputs and equations of a flattened model.
@@ -128,6 +132,10 @@ class FlatModel:
                                 ("_variable_column", self.variables, variables)):
             if col is not None and col.numel() == len(items):
                 self.__dict__[key] = ((id(items), len(items)), col)
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickled without the memoized columns and incidence (rebuilt on demand)."""
+        return {k: v for k, v in self.__dict__.items() if k not in _MEMOS}
 
     def _stacked(self, key: str, items: list, scalars) -> ca.SX:
         tag = (id(items), len(items))
