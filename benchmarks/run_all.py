@@ -316,9 +316,11 @@ def table(report: dict) -> str:
                      f"{r['compile']:.3f} s | {r['compile'] / r['cached_compile']:.1f}x faster |"
                      " |")
     for name, r in report.get("jit", {}).items():
+        pays = (f"{r['speedup']:.2f}x faster; pays off after {r['crossover_runs']} runs"
+                if r["speedup"] > 1
+                else f"{1 / r['speedup']:.2f}x slower in this run; never pays off")
         lines.append(f"| `simulate(jit=True)`, {name}, per 10-s run | {r['run_jit'] * 1e3:.1f} ms"
-                     f" | without JIT {r['run_plain'] * 1e3:.1f} ms | {r['speedup']:.2f}x faster"
-                     f"; pays off after {r['crossover_runs']} runs | |")
+                     f" | without JIT {r['run_plain'] * 1e3:.1f} ms | {pays} | |")
     fc = report.get("fmu_cs")
     if fc:
         lines.append(f"| robot CS FMU, fmpy `simulate_fmu`, 10 s | {fc['fmu_cs_fmpy'] * 1e3:.1f} ms"
