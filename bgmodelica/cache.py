@@ -250,12 +250,24 @@ class _Pickler(pickle.Pickler):
     def __init__(self, f: Any) -> None:
         super().__init__(f, protocol=pickle.HIGHEST_PROTOCOL)
         self.sx: list[ca.SX] = []
-        self.dispatch_table = {**copyreg.dispatch_table, ca.SX: self._set_aside,
-                               ca.Function: _refuse, ca.MX: _refuse}
+        self.dispatch_table = {**copyreg.dispatch_table,
+                               **{cls: _refuse for cls in _subclasses(Element)},
+                               ca.SX: self._set_aside, ca.Function: _refuse, ca.MX: _refuse}
 
     def _set_aside(self, obj: ca.SX) -> tuple:
         self.sx.append(obj)                       # the pickle memo sees each object once
         return (_stored_sx, (len(self.sx) - 1,))
+
+
+def _subclasses(cls: type) -> set[type]:
+    """``cls`` and every class derived from it (the dispatch table matches exact types)."""
+    out, todo = {cls}, [cls]
+    while todo:
+        for sub in todo.pop().__subclasses__():
+            if sub not in out:
+                out.add(sub)
+                todo.append(sub)
+    return out
 
 
 def _refuse(obj: Any) -> tuple:

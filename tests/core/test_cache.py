@@ -103,3 +103,12 @@ def test_cli_cache_flag(tmp_path):
     for _ in range(2):
         out = subprocess.run(env_cmd, capture_output=True, text=True, check=True, env=env)
     assert '"cache_load"' in out.stdout and len(entries(tmp_path)) == 1
+
+
+def test_a_compiled_model_referring_to_a_component_is_not_stored(tmp_path):
+    """The store refuses objects it cannot describe (a model element, a CasADi Function)
+    instead of pickling them along."""
+    compiled = bg.compile(RC())
+    compiled.dae.hybrid = RC()            # a component where none may be
+    assert disk.store(compiled, tmp_path, "k" * 64) is None
+    assert not list(tmp_path.rglob("*.bgmc"))
