@@ -487,13 +487,13 @@ def check_export_args(args: Any) -> None:
 
 # -- model building --------------------------------------------------------------------------
 
-def guarded_equations(elem: Any, where: str, path: str):
-    """``elem.all_equations()``, with an exception raised by the user's ``equations()``
+def guarded_equations(elem: Any, where: str, path: str, blocks: bool = False):
+    """``elem.all_equations(blocks)``, with an exception raised by the user's ``equations()``
     turned into a :class:`UserCodeError` naming the component ``where`` and the user's file
     and line, and model errors raised there prefixed with ``where``."""
     from .errors import ConnectError, EquationError, ModelError
 
-    it = iter(elem.all_equations())
+    it = iter(elem.all_equations(blocks))
     while True:
         try:
             eq = next(it)

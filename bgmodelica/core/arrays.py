@@ -9,10 +9,12 @@ indexed and sliced 0-based like a numpy vector::
     yield self.i[1:] == (self.v[:-1] - self.v[1:]) / self.R[1:]
 
 Operators work elementwise with numpy broadcasting (scalars, numbers, numpy arrays of numbers
-and other arrays); ``a == b`` is an :class:`ArrayEquation`, expanded into its scalar
-equations when the component's equations are read. Flattening lowers the equations of one
-array equation together (one CasADi operation per operator on whole vectors, see
-:mod:`.expr`), and the structural passes see the scalars.
+and other arrays) and are *lazy*: ``(self.v[:-1] - self.v[1:]) / self.R[1:]`` is one tree of
+whole-array operations, not one expression per element. ``a == b`` is an
+:class:`ArrayEquation`; flattening lowers it as one block (one CasADi operation per operator on
+whole vectors), and the structural passes see its scalars. Indexing one element of a computed
+array, iterating, ``sum``, ``@`` and functions other than the math functions build the
+elements on demand.
 
 ``array_of(Resistor, n, R=values)`` builds ``n`` components named ``R[1] .. R[n]`` when added
 to a model; ``arr.p`` is the array of their connectors and ``connect`` joins arrays of
@@ -28,7 +30,11 @@ from typing import Any
 import numpy as np
 
 from ..errors import ConnectError, DeclarationError, EquationError
-from .expr import ArrayBase, Equation, Expr, Number
+from .expr import ArrayBase, Equation, Expr, Leaf, Number, to_text
+
+#: math functions that stay whole-array operations (``sin(arr)``)
+LAZY_FUNCTIONS = frozenset({"sin", "cos", "tan", "exp", "log", "sqrt", "asin", "acos", "atan",
+                            "sinh", "cosh", "tanh", "fabs", "sign"})
 
 
 def element_names(name: str, shape: tuple[int, ...]) -> list[str]:
@@ -102,27 +108,86 @@ def _elementwise(fun: Any, *args: Any) -> Any:
     return _wrap(out)
 
 
-class ArrayExpr(ArrayBase):
-    """An array of scalar expressions (0-based indexing and slicing, numpy broadcasting)."""
+_FUNCTIONS: dict[str, Any] = {
+    "+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b,
+    "/": lambda a, b: a / b, "**": lambda a, b: a ** b, "neg": lambda a: -a,
+}
 
-    __slots__ = ("items",)
+
+def _function(op: str) -> Any:
+    if op in _FUNCTIONS:
+        return _FUNCTIONS[op]
+    from . import expr
+
+    return getattr(expr, op)
+
+
+def _lazy(op: str, *args: Any) -> Any:
+    """``op`` over whole arrays as one node (shape by numpy broadcasting); operands other
+    than arrays, numbers, numeric numpy arrays and scalar expressions go elementwise."""
+    operands: list[Any] = []
+    shapes: list[tuple[int, ...]] = []
+    for x in args:
+        if isinstance(x, ArrayExpr):
+            shapes.append(x.shape)
+        elif isinstance(x, Number):
+            x = float(x)
+        elif isinstance(x, np.ndarray) and x.dtype.kind in "biuf":
+            x = x.astype(float)
+            shapes.append(x.shape)
+        elif not isinstance(x, Expr):
+            return _elementwise(_function(op), *args)
+        operands.append(x)
+    try:
+        shape = np.broadcast_shapes(*shapes)
+    except ValueError:
+        shown = " and ".join(str(s) for s in shapes)
+        raise EquationError(f"array shapes {shown} do not match") from None
+    return ArrayExpr(node=(op, tuple(operands)), shape=shape)
+
+
+class ArrayExpr(ArrayBase):
+    """An array of scalar expressions (0-based indexing and slicing, numpy broadcasting).
+
+    Stored element by element (``items``, an object array of expressions), or lazy:
+    ``node = (operator, operands)`` over whole arrays, numbers, numeric numpy arrays and
+    scalar expressions, whose elements are built only when asked for."""
+
+    __slots__ = ("_items", "node", "_shape")
     __array_priority__ = 2000        # numpy arrays defer to our operators
     __array_ufunc__ = None
 
-    def __init__(self, items: Any) -> None:
-        self.items = np.asarray(items, dtype=object)
+    def __init__(self, items: Any = None, *, node: tuple[str, tuple] | None = None,
+                 shape: tuple[int, ...] = ()) -> None:
+        self.node = node
+        if node is None:
+            self._items: np.ndarray | None = np.asarray(items, dtype=object)
+            self._shape = self._items.shape
+        else:
+            self._items = None
+            self._shape = tuple(shape)
+
+    @property
+    def items(self) -> np.ndarray:
+        """The elements (built on first use for a lazy array)."""
+        if self._items is None:
+            op, args = self.node                 # type: ignore[misc]
+            out = _elementwise(_function(op), *args)
+            self._items = out.items if isinstance(out, ArrayExpr) else \
+                np.full(self._shape, out, dtype=object)
+        return self._items
 
     # -- container -------------------------------------------------------------------------
     @property
     def shape(self) -> tuple[int, ...]:
-        return self.items.shape
+        return self._shape
 
     @property
     def size(self) -> int:
-        return int(self.items.size)
+        return int(np.prod(self._shape))
 
     def __len__(self) -> int:
-        return len(self.items)
+        return self._shape[0]
 
     def __iter__(self) -> Iterator[Any]:
         for item in self.items:
@@ -139,17 +204,17 @@ class ArrayExpr(ArrayBase):
         return ArrayExpr(self.items.ravel())
 
     # -- arithmetic ------------------------------------------------------------------------
-    def __add__(self, o): return _elementwise(lambda a, b: a + b, self, o)
-    def __radd__(self, o): return _elementwise(lambda a, b: a + b, o, self)
-    def __sub__(self, o): return _elementwise(lambda a, b: a - b, self, o)
-    def __rsub__(self, o): return _elementwise(lambda a, b: a - b, o, self)
-    def __mul__(self, o): return _elementwise(lambda a, b: a * b, self, o)
-    def __rmul__(self, o): return _elementwise(lambda a, b: a * b, o, self)
-    def __truediv__(self, o): return _elementwise(lambda a, b: a / b, self, o)
-    def __rtruediv__(self, o): return _elementwise(lambda a, b: a / b, o, self)
-    def __pow__(self, o): return _elementwise(lambda a, b: a ** b, self, o)
-    def __rpow__(self, o): return _elementwise(lambda a, b: a ** b, o, self)
-    def __neg__(self): return _elementwise(lambda a: -a, self)
+    def __add__(self, o): return _lazy("+", self, o)
+    def __radd__(self, o): return _lazy("+", o, self)
+    def __sub__(self, o): return _lazy("-", self, o)
+    def __rsub__(self, o): return _lazy("-", o, self)
+    def __mul__(self, o): return _lazy("*", self, o)
+    def __rmul__(self, o): return _lazy("*", o, self)
+    def __truediv__(self, o): return _lazy("/", self, o)
+    def __rtruediv__(self, o): return _lazy("/", o, self)
+    def __pow__(self, o): return _lazy("**", self, o)
+    def __rpow__(self, o): return _lazy("**", o, self)
+    def __neg__(self): return _lazy("neg", self)
     def __pos__(self): return self
     def __lt__(self, o): return _elementwise(lambda a, b: a < b, self, o)
     def __le__(self, o): return _elementwise(lambda a, b: a <= b, self, o)
@@ -179,10 +244,16 @@ class ArrayExpr(ArrayBase):
         return out
 
     def map(self, fun: Any) -> Any:
-        """``fun`` applied to every element (e.g. a math function)."""
+        """``fun`` applied to every element (the math functions of :mod:`bgmodelica` stay
+        one lazy whole-array operation)."""
+        name = getattr(fun, "__name__", "")
+        if name in LAZY_FUNCTIONS and fun is _function(name):
+            return _lazy(name, self)
         return _elementwise(fun, self)
 
     def __repr__(self) -> str:
+        if self._items is None:
+            return f"ArrayExpr(shape={self.shape}: {array_text(self)})"
         shown = ", ".join(repr(x) for x in self.items.ravel()[:4])
         more = ", ..." if self.size > 4 else ""
         return f"ArrayExpr(shape={self.shape}: {shown}{more})"
@@ -195,6 +266,22 @@ class ArrayEquation:
 
     def __init__(self, lhs: Any, rhs: Any) -> None:
         self.lhs, self.rhs = lhs, rhs
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """The broadcast shape of the two sides (the shape of the scalar equations)."""
+        try:
+            return np.broadcast_shapes(_shape(self.lhs), _shape(self.rhs))
+        except ValueError:
+            raise EquationError(
+                f"array equation sides have shapes {_shape(self.lhs)} and "
+                f"{_shape(self.rhs)}, which do not match") from None
+
+    def is_block(self) -> bool:
+        """Whether flattening lowers this equation as one block: its sides are built from
+        arrays of declared scalars, whole-array arithmetic and math functions, numbers,
+        numeric arrays and scalar expressions without relations or events."""
+        return _block_operand(self.lhs) and _block_operand(self.rhs)
 
     def equations(self) -> list[Equation]:
         try:
@@ -210,13 +297,64 @@ class ArrayEquation:
         return iter(self.equations())
 
     def __len__(self) -> int:
-        return len(self.equations())
+        return int(np.prod(self.shape))
 
     def __bool__(self) -> bool:
         raise TypeError("an equation 'a == b' has no truth value; yield it from equations()")
 
     def __repr__(self) -> str:
-        return f"ArrayEquation({self.lhs!r} == {self.rhs!r})"
+        return f"{array_text(self.lhs)} == {array_text(self.rhs)}"
+
+
+def _shape(x: Any) -> tuple[int, ...]:
+    if isinstance(x, ArrayExpr):
+        return x.shape
+    return np.shape(_items(x))
+
+
+_SMOOTH_OPS = frozenset(_FUNCTIONS) | LAZY_FUNCTIONS | {"atan2", "fmin", "fmax"}
+
+
+def _block_operand(x: Any) -> bool:
+    if isinstance(x, ArrayExpr):
+        if x.node is None:
+            return all(isinstance(item, Leaf) for item in x.items.flat)
+        return all(_block_operand(a) for a in x.node[1])
+    if isinstance(x, (Number, float)):
+        return True
+    if isinstance(x, np.ndarray):
+        return x.dtype.kind in "biuf"
+    if isinstance(x, Leaf):
+        return True
+    if isinstance(x, Expr):
+        return getattr(x, "op", None) in _SMOOTH_OPS and all(_block_operand(a) for a in x.args)
+    return False
+
+
+def array_text(x: Any) -> str:
+    """Readable text of an array expression: ``(v[1:4] - v[2:5])/R[2:5]``."""
+    if isinstance(x, ArrayExpr):
+        if x.node is None:
+            items = list(x.items.flat)
+            if items and all(isinstance(i, Leaf) for i in items):
+                parts = compact_names([to_text(i) for i in items])
+            else:
+                parts = [to_text(i) for i in items[:3]] + (["..."] if len(items) > 3 else [])
+            return parts[0] if len(parts) == 1 else "{" + ", ".join(parts) + "}"
+        op, args = x.node
+        texts = [array_text(a) for a in args]
+        if op in _INFIX:
+            return f"({texts[0]}{_INFIX[op]}{texts[1]})"
+        if op == "neg":
+            return f"-{texts[0]}"
+        return f"{op}({', '.join(texts)})"
+    if isinstance(x, np.ndarray):
+        shown = ", ".join(f"{v:g}" for v in x.ravel()[:3])
+        return "{" + shown + (", ..." if x.size > 3 else "") + "}"
+    return to_text(x)
+
+
+_INFIX = {"+": " + ", "-": " - ", "*": "*", "/": "/", "**": "^"}
 
 
 class ElementArray:

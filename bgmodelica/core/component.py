@@ -429,9 +429,10 @@ class Component(Element):
         """Imperative form: add equations ``lhs == rhs`` to this component."""
         self._equations.extend(eqs)
 
-    def all_equations(self) -> Iterator[Any]:
+    def all_equations(self, blocks: bool = False) -> Iterator[Any]:
         """Equations of every class in the hierarchy (base classes first), then added ones;
-        array equations and lists of connections come out as their scalar items."""
+        array equations and lists of connections come out as their scalar items (with
+        ``blocks``, array equations that flattening lowers whole stay whole)."""
         for cls in reversed(type(self).__mro__):
             own = vars(cls).get("equations")
             if own is not None:
@@ -439,21 +440,26 @@ class Component(Element):
                 if result is not None:
                     for item in result:
                         if isinstance(item, (ArrayEquation, list)):
-                            yield from _scalar_items(item)
+                            yield from _scalar_items(item, blocks)
                         else:
                             yield item
         for item in self._equations:
             if isinstance(item, (ArrayEquation, list)):
-                yield from _scalar_items(item)
+                yield from _scalar_items(item, blocks)
             else:
                 yield item
 
 
-def _scalar_items(item: Any) -> Iterator[Any]:
-    """The scalar equations of an array equation, the connections of a list of them (as
-    ``connect`` over arrays makes); anything else as it is."""
+def _scalar_items(item: Any, blocks: bool = False) -> Iterator[Any]:
+    """The scalar equations of an array equation (or the equation itself, as a block), the
+    connections of a list of them (as ``connect`` over arrays makes); anything else as it
+    is."""
     if isinstance(item, ArrayEquation):
-        yield from item.equations()
+        if blocks and item.is_block():
+            item.shape                          # noqa: B018 - sides that do not match: say so
+            yield item
+        else:
+            yield from item.equations()
     elif item and all(isinstance(c, Connection) for c in item):
         yield from item
     else:

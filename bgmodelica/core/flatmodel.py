@@ -75,7 +75,8 @@ class EquationSources:
     flattening grouped them. draft: the hybrid part (relations, when-clauses, clocks), a
     :class:`~bgmodelica.core.flatten_hybrid.HybridDraft` or None. bindings: parameters bound to
     expressions ``(dotted name, declaration, origin)``. links: connected signals ``(a, b,
-    origin)``. initial: initial equations ``(Equation, origin)``.
+    origin)``. initial: initial equations ``(Equation, origin)``. arrays: array equations
+    lowered as blocks ``(ArrayEquation, origin)``.
     """
 
     groups: dict[Any, list] = field(default_factory=dict)
@@ -83,6 +84,7 @@ class EquationSources:
     bindings: list[tuple[str, Any, str]] = field(default_factory=list)
     links: list[tuple[Any, Any, str]] = field(default_factory=list)
     initial: list[tuple[Any, str]] = field(default_factory=list)
+    arrays: list[tuple[Any, str]] = field(default_factory=list)
 
 
 #: per-model memos kept in ``FlatModel.__dict__`` (not pickled)

@@ -16,12 +16,24 @@ from dataclasses import replace
 from typing import Any
 
 import casadi as ca
+import numpy as np
 
 from ..errors import ConnectError, DeclarationError, EquationError
 from ..validate import check_binding, check_sx_binding, guarded_equations
 from . import flatten_hybrid
+from .arrays import ArrayEquation, ArrayExpr
 from .component import Component, Connection, Connector, Element
-from .expr import HYBRID_NODES, Equation, Expr, Leaf, Number, lower_group, shape_of, to_sx
+from .expr import (
+    HYBRID_NODES,
+    Equation,
+    Expr,
+    Leaf,
+    Number,
+    apply_op,
+    lower_group,
+    shape_of,
+    to_sx,
+)
 from .flatmodel import EquationSources, FlatEquation, FlatModel, FlatVariable, take
 from .variables import (
     KIND_FLOW,
@@ -57,6 +69,7 @@ class _Flattener:
         self.slot: dict[int, int] = {}            # id(Symbol) -> index in discretes
         self.full: dict[int, str] = {}            # id(Symbol) -> dotted name
         self.groups: dict[Any, list] = {}         # equation shape -> members (as written)
+        self.blocks: list[tuple[ArrayEquation, str]] = []   # array equations lowered whole
         self.initial_sources: list[tuple[Equation, str]] = []   # initial equations as written
 
     # -- tree walk -------------------------------------------------------------------------
@@ -73,7 +86,7 @@ class _Flattener:
                 self.parents[id(elem)] = parent
             self.elements.append(elem)
             if isinstance(elem, Component):
-                for eq in guarded_equations(elem, self.where(elem), path):
+                for eq in guarded_equations(elem, self.where(elem), path, blocks=True):
                     if isinstance(eq, Connection):
                         self.connections.append((eq, elem))
                     else:
@@ -154,7 +167,8 @@ class _Flattener:
                     if isinstance(p.decl.value, Expr)]
         links = [(c.a, c.b, self.where(ctx)) for c, ctx in self.connections
                  if not isinstance(c.a, Connector)]
-        return EquationSources(self.groups, self.draft, bindings, links, self.initial_sources)
+        return EquationSources(self.groups, self.draft, bindings, links, self.initial_sources,
+                               self.blocks)
 
     def where(self, elem: Element) -> str:
         """``path (Class)`` of an element, for equation origins and messages."""
@@ -360,6 +374,9 @@ class _Flattener:
         slow: list[tuple[ca.SX, str]] = []
         for eq, ctx in self.pending:
             where = self.where(ctx)
+            if isinstance(eq, ArrayEquation):
+                self.blocks.append((eq, where))
+                continue
             if isinstance(eq, Equation):
                 if isinstance(eq.lhs, (ca.SX, ca.MX)) or isinstance(eq.rhs, (ca.SX, ca.MX)):
                     slow.append((to_sx(eq.lhs) - to_sx(eq.rhs), where))
@@ -385,6 +402,8 @@ class _Flattener:
         self.groups = groups
         for key, members in groups.items():
             self._lower(key, members)
+        for eq, where in self.blocks:
+            self._lower_block(eq, where)
         if slow:
             self._check_slow(slow)
             self.equations.extend(FlatEquation(r, where) for r, where in slow)
@@ -422,6 +441,77 @@ class _Flattener:
                 alias = self._alias_of(signs[0], leaves[0], signs[1], leaves[1])
             self.equations.append(FlatEquation(r, where, alias))
         self.columns.append(res)
+
+    def _lower_block(self, eq: ArrayEquation, where: str) -> None:
+        """One array equation as one residual column: leaves are slices of the model's
+        symbol vector, operators act on whole vectors (numpy broadcasting by index)."""
+        shape = eq.shape
+        size = int(np.prod(shape))
+        found: list[bool] = []
+        res = ca.SX(self._block(eq.lhs, shape, eq, where, found)
+                    - self._block(eq.rhs, shape, eq, where, found))
+        if not found:
+            raise EquationError(f"{where}: equation {eq!r} has no variables")
+        if res.numel() != size:
+            res = ca.repmat(res, size, 1)
+        parts = ca.vertsplit(res) if size > 1 else [res]
+        links = self._block_aliases(eq, shape)
+        if links is None:
+            self.equations.extend(FlatEquation(r, where) for r in parts)
+        else:
+            self.equations.extend(FlatEquation(r, where, a)
+                                  for r, a in zip(parts, links, strict=True))
+        self.columns.append(res)
+
+    def _block(self, x: Any, shape: tuple[int, ...], eq: ArrayEquation, where: str,
+               found: list[bool]) -> Any:
+        """``x`` lowered to a column of ``prod(shape)`` elements (C order) or a scalar."""
+        if isinstance(x, ArrayExpr):
+            if x.node is None:
+                items = x.items.ravel()
+                pos = self.pos
+                try:
+                    idx = [pos[id(leaf.sym)] for leaf in items]
+                except KeyError:
+                    sym = next(leaf.sym for leaf in items if id(leaf.sym) not in pos)
+                    raise self._alien(sym, eq, where) from None
+                found.append(True)
+                col = self.all_sx[idx]
+            else:
+                op, args = x.node
+                col = apply_op(op, [self._block(a, x.shape, eq, where, found) for a in args])
+            return _broadcast(col, x.shape, shape)
+        if isinstance(x, np.ndarray):
+            return ca.DM(np.broadcast_to(x.astype(float), shape).ravel())
+        if isinstance(x, Expr):
+            leaves: list = []
+            shape_of(x, leaves, [])
+            for sym in leaves:
+                if id(sym) not in self.pos:
+                    raise self._alien(sym, eq, where)
+            found.extend(True for _ in leaves[:1])
+            return to_sx(x)
+        return float(x)
+
+    def _alien(self, sym: Any, eq: Any, where: str) -> EquationError:
+        owner = getattr(sym, "owner", None)
+        return EquationError(
+            f"{where}: equation {eq!r} uses {getattr(sym, 'name', sym)}"
+            + (f" of {type(owner).__name__}" if owner is not None else "")
+            + ", which is not part of the model (add its component to the model)")
+
+    def _block_aliases(self, eq: ArrayEquation, shape: tuple[int, ...]) -> list | None:
+        """Per element, the alias link of an array equation ``a == b``, ``a == -b``,
+        ``a + b == 0``... between two arrays of variables; None for any other form."""
+        leaves: list = []
+        consts: list = []
+        signs = _alias_signs(_block_shape(eq.lhs, leaves, consts),
+                             _block_shape(eq.rhs, leaves, consts))
+        if not signs or any(np.any(np.asarray(c) != 0.0) for c in consts):
+            return None
+        a, b = (np.broadcast_to(arr.items, shape).ravel() for arr in leaves)
+        sa, sb = signs
+        return [self._alias_of(sa, la.sym, sb, lb.sym) for la, lb in zip(a, b, strict=True)]
 
     def _alias_of(self, sa: float, a: Any, sb: float, b: Any) -> tuple[int, int, float] | None:
         """``sa*a + sb*b = 0`` as the alias link ``a = -sb/sa * b``, if both are variables."""
@@ -494,6 +584,28 @@ def _count_consts(shape: Any) -> int:
     if shape == "L":
         return 0
     return sum(_count_consts(a) for a in shape[1:])
+
+
+def _block_shape(x: Any, leaves: list, consts: list) -> Any:
+    """The shape of an array expression for :func:`_alias_signs`: stored arrays are leaves
+    ``"L"``, numbers and numeric arrays constants ``"C"``, scalar expressions ``"X"``."""
+    if isinstance(x, ArrayExpr):
+        if x.node is None:
+            leaves.append(x)
+            return "L"
+        return (x.node[0], *[_block_shape(a, leaves, consts) for a in x.node[1]])
+    if isinstance(x, Expr):
+        return "X"
+    consts.append(x)
+    return "C"
+
+
+def _broadcast(col: Any, have: tuple[int, ...], want: tuple[int, ...]) -> Any:
+    """A column of shape ``have`` (C order) repeated to ``want`` by numpy broadcasting."""
+    if have == want or int(np.prod(have)) == 1:
+        return col
+    idx = np.broadcast_to(np.arange(int(np.prod(have))).reshape(have), want).ravel()
+    return col[idx.tolist()]
 
 
 def _alias_signs(shape_l: Any, shape_r: Any) -> tuple[float, ...]:

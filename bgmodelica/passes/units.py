@@ -21,7 +21,9 @@ it meets, like a literal. The rules:
 The check reads :class:`~bgmodelica.core.flatmodel.EquationSources`, which flattening fills
 with the equations grouped by *shape*: within a group the verdict depends only on the units
 of the leaves, so it is computed once per shape and tuple of leaf units (a 10,000-section RC
-ladder has a handful of them).
+ladder has a handful of them). An array equation lowered as a block is checked once, on the
+equation of its first elements, when each of its arrays holds one unit (element by element
+otherwise).
 """
 
 from __future__ import annotations
@@ -32,7 +34,10 @@ from collections.abc import Callable
 from fractions import Fraction
 from typing import Any
 
-from ..core.expr import Equation, Expr, Leaf, Number, to_text
+import numpy as np
+
+from ..core.arrays import ArrayExpr, array_text
+from ..core.expr import Equation, Expr, Leaf, Number, Op, to_text
 from ..core.flatmodel import EquationSources, FlatModel
 from ..core.hybrid import Reinit, SampleClock
 from ..core.units import ONE, SECOND, Unit, UnitParseError, name_of, parse
@@ -232,6 +237,7 @@ class _Checker:
 
     def run(self, src: EquationSources) -> list[str]:
         self._groups(src.groups)
+        self._arrays(src.arrays)
         if src.draft is not None:
             self._hybrid(src.draft)
         for name, decl, where in src.bindings:
@@ -276,6 +282,17 @@ class _Checker:
                 _, _, where, eq = members[first[k]]
                 self._guard(lambda w=where, e=eq: f"{w}: {to_text(e.lhs)} == {to_text(e.rhs)}",
                             lambda e=eq: self.equation(e), n)
+
+    def _arrays(self, arrays: list[tuple[Any, str]]) -> None:
+        for eq, where in arrays:
+            try:
+                first = Equation(_first(eq.lhs), _first(eq.rhs))
+            except _Varies:
+                self._groups(_scalar_groups(eq.equations(), where))
+                continue
+            self._guard(lambda w=where, e=eq: f"{w}: {array_text(e.lhs)} == "
+                                              f"{array_text(e.rhs)}",
+                        lambda e=first: self.equation(e), len(eq))
 
     def equation(self, eq: Equation) -> Any:
         lhs, rhs = self.infer(eq.lhs), self.infer(eq.rhs)
@@ -420,6 +437,47 @@ def _other_key(sym: Any) -> Any:
     if isinstance(decl, Integer):
         return decl.unit or "1"
     return decl.unit
+
+
+class _Varies(Exception):
+    """An array of an array equation holds leaves of different units."""
+
+
+def _first(x: Any) -> Any:
+    """The first element of an array expression whose arrays each hold one unit (raises
+    :class:`_Varies` otherwise), for checking all elements at once."""
+    if isinstance(x, ArrayExpr):
+        if x.node is None:
+            items = x.items.ravel()
+            if len({_leaf_key(leaf.sym) for leaf in items}) > 1:
+                raise _Varies
+            return items[0]
+        op, args = x.node
+        if op == "**" and isinstance(args[1], np.ndarray) and np.unique(args[1]).size > 1:
+            raise _Varies
+        return Op(op, tuple(_first(a) for a in args))
+    if isinstance(x, np.ndarray):
+        return float(x.ravel()[0])
+    return x
+
+
+def _scalar_groups(equations: list[Equation], where: str) -> dict[Any, list]:
+    """Scalar equations grouped by shape, as flattening groups them."""
+    from ..core.expr import shape_of
+
+    out: dict[Any, list] = {}
+    for eq in equations:
+        leaves: list = []
+        consts: list = []
+        shape = []
+        for side in (eq.lhs, eq.rhs):
+            if isinstance(side, Expr):
+                shape.append(shape_of(side, leaves, consts))
+            else:
+                consts.append(float(side))
+                shape.append("C")
+        out.setdefault(tuple(shape), []).append((leaves, consts, where, eq))
+    return out
 
 
 def _has_pow(shape: Any) -> bool:
