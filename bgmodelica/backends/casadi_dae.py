@@ -142,8 +142,10 @@ def build_dae(sorted_dae: SortedDAE) -> CasadiDAE:
     states = sorted_dae.states
     alg_vars = sorted_dae.algebraic
 
-    free_params = [p for p in model.parameters if not isinstance(p.decl.value, ca.SX)]
-    bound = [p for p in model.parameters if isinstance(p.decl.value, ca.SX)]
+    bound = [p for p in model.parameters if type(p.decl.value) is not float
+             and isinstance(p.decl.value, ca.SX)]
+    free_params = [p for p in model.parameters if not isinstance(p.decl.value, ca.SX)] \
+        if bound else list(model.parameters)
 
     # columns are taken from the model's stacked symbols: no scalar restacking
     column = model.stacked_variables()
@@ -182,7 +184,8 @@ def build_dae(sorted_dae: SortedDAE) -> CasadiDAE:
     # condition on the continuous initial state
     fixed = [(k, float(v.decl.start)) for k, v in enumerate(variables)
              if v.der_of < 0 and getattr(v.decl, "fixed", False) and v.decl.kind != "discrete"]
-    p = ca.vertcat(*[q.sx for q in free_params], *[u.sx for u in model.inputs],
+    p = ca.vertcat(model.stacked_parameters() if not bound else
+                   ca.vertcat(*[q.sx for q in free_params]), *[u.sx for u in model.inputs],
                    *[d.sx for d in model.discretes])
     return CasadiDAE(
         x=take(column, list(states)),

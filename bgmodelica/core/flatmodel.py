@@ -88,7 +88,8 @@ class EquationSources:
 
 
 #: per-model memos kept in ``FlatModel.__dict__`` (not pickled)
-_MEMOS = frozenset({"_residual_column", "_variable_column", "_incidence_memo"})
+_MEMOS = frozenset({"_residual_column", "_variable_column", "_parameter_column",
+                    "_incidence_memo"})
 
 
 @dataclass
@@ -126,14 +127,26 @@ class FlatModel:
         return self._stacked("_variable_column", self.variables,
                              lambda: [v.sx for v in self.variables])
 
+    def stacked_parameters(self) -> ca.SX:
+        """Every parameter's symbol in one SX column (memoized like
+        :meth:`stacked_residuals`)."""
+        return self._stacked("_parameter_column", self.parameters,
+                             lambda: [p.sx for p in self.parameters])
+
     def remember_stacked(self, residuals: ca.SX | None = None,
-                         variables: ca.SX | None = None) -> None:
+                         variables: ca.SX | None = None, parameters: ca.SX | None = None,
+                         like: FlatModel | None = None) -> None:
         """Record columns a pass already holds (same order as the lists) for the
-        ``stacked_*`` methods."""
+        ``stacked_*`` methods; ``like``: a model whose memoized columns of the same lists
+        (the same list objects) carry over."""
         for key, items, col in (("_residual_column", self.equations, residuals),
-                                ("_variable_column", self.variables, variables)):
+                                ("_variable_column", self.variables, variables),
+                                ("_parameter_column", self.parameters, parameters)):
             if col is not None and col.numel() == len(items):
                 self.__dict__[key] = ((id(items), len(items)), col)
+            elif like is not None and key in like.__dict__ \
+                    and like.__dict__[key][0] == (id(items), len(items)):
+                self.__dict__[key] = like.__dict__[key]
 
     def __getstate__(self) -> dict[str, Any]:
         """Pickled without the memoized columns and incidence (rebuilt on demand)."""

@@ -102,7 +102,9 @@ class _Flattener:
         self._component_equations()
         initial = self._initial_equations()
         sources = self._sources(parameters)
-        parameters = [self._lower_binding(p) for p in parameters]
+        declared = parameters
+        parameters = [p if type(p.decl.value) is float else self._lower_binding(p)
+                      for p in parameters]
         hybrid = None
         if self.draft is not None:
             hybrid = flatten_hybrid.lower(self.draft, lambda s: self.slot[id(s)],
@@ -111,8 +113,9 @@ class _Flattener:
                          discretes=discretes, hybrid=hybrid, sources=sources,
                          initial_equations=initial)
         flat.remember_stacked(ca.vertcat(*self.columns) if self.columns else None,
-                              take(self.all_sx, [self.pos[id(sym)] for sym, target, _ in symbols
-                                                 if target is variables]))
+                              *[take(self.all_sx, [self.pos[id(sym)] for sym, target, _ in symbols
+                                                   if target is kind])
+                                for kind in (variables, declared)])
         return flat
 
     def _initial_equations(self) -> list[FlatEquation]:

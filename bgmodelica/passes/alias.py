@@ -100,7 +100,7 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
     out = FlatModel(model.name, final, model.parameters, model.inputs, equations, aliases,
                     model.discretes, hybrid)
     out.initial_equations = initial if n_init else []
-    out.remember_stacked(residuals=kept_column, variables=take(column, keep_idx))
+    out.remember_stacked(residuals=kept_column, variables=take(column, keep_idx), like=model)
     return out
 
 

@@ -9,8 +9,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..core.flatmodel import FlatModel
 from ..errors import UnbalancedModelError
+from ..structure.compiled import derivative_bases, remap_rows
 from ..structure.diagnosis import dulmage_mendelsohn
 from ..structure.matching import maximum_matching
 from .reference import likely_causes
@@ -29,25 +32,15 @@ class BalanceReport:
         return self.n_equations == self.n_unknowns
 
 
-def base_of(model: FlatModel) -> list[int]:
-    """For each variable, the index of the variable it is a derivative of (itself if none)."""
-    base = list(range(len(model.variables)))
-    for i in range(len(model.variables)):
-        j = i
-        while model.variables[j].der_of >= 0:
-            j = model.variables[j].der_of
-        base[i] = j
-    return base
-
-
 def check_balance(model: FlatModel, max_listed: int = 12) -> BalanceReport:
     """Raise :class:`UnbalancedModelError` naming the culprits unless the model is balanced."""
     unknowns = model.unknowns
     report = BalanceReport(len(model.equations), len(unknowns))
-    column = {v: k for k, v in enumerate(unknowns)}
-    base = base_of(model)
+    base = derivative_bases([v.der_of for v in model.variables])
+    column = np.full(len(model.variables), -1, dtype=np.int64)
+    column[unknowns] = np.arange(len(unknowns))
     inc = model_incidence(model)
-    eq_vars = [sorted({column[base[j]] for j in row}) for row in inc]
+    eq_vars = remap_rows(inc, column[base])
     for k, row in enumerate(eq_vars):
         if not row:
             raise UnbalancedModelError(

@@ -99,7 +99,7 @@ def reduce_index(model: FlatModel | ReducedModel,
     aug.remember_stacked(      # the old columns, extended by what was added
         ca.vertcat(model.stacked_residuals(), *[e.residual for e in equations[n_old:]]),
         ca.vertcat(model.stacked_variables(),
-                   *[v.sx for v in variables[len(model.variables):]]))
+                   *[v.sx for v in variables[len(model.variables):]]), like=model)
     eq_derivative = (links + [-1] * (len(equations) - len(links))) if links \
         else [-1] * len(equations)
     for new, of in pant.new_equations:

@@ -15,11 +15,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import casadi as ca
+import numpy as np
 
 from ..core.flatmodel import take
 from ..diagnose import singular_linear_block
 from ..errors import EquationError, UnbalancedModelError
-from ..structure import block_lower_triangular, maximum_matching, tear
+from ..structure import block_lower_triangular, compiled, maximum_matching, tear
+from ..structure.compiled import remap_rows
 from .index_reduction import ReducedModel
 from .symbolic import LONG_ROW, solve_linear_block, solve_linear_scalar, solve_scalar_blocks
 
@@ -83,8 +85,13 @@ def sort_equations(reduced: ReducedModel) -> SortedDAE:
     variables = model.variables
     states = set(reduced.states)
     unknowns = [j for j in range(len(variables)) if j not in states]
-    column = {j: k for k, j in enumerate(unknowns)}
-    eq_cols = [[column[j] for j in row if j in column] for row in reduced.graph.eq_vars]
+    if len(unknowns) >= compiled.LARGE:        # in numpy (rows come out ascending)
+        column = np.full(len(variables), -1, dtype=np.int64)
+        column[unknowns] = np.arange(len(unknowns))
+        eq_cols = remap_rows(reduced.graph.eq_vars, column)
+    else:
+        where = {j: k for k, j in enumerate(unknowns)}
+        eq_cols = [[where[j] for j in row if j in where] for row in reduced.graph.eq_vars]
     if len(eq_cols) != len(unknowns):
         raise UnbalancedModelError(
             f"after index reduction {model.name} has {len(eq_cols)} equations for "
@@ -108,24 +115,28 @@ def sort_equations(reduced: ReducedModel) -> SortedDAE:
     blocks = block_lower_triangular(eq_cols, len(unknowns), matching)
     scalar = [b for b in blocks if len(b.eqs) == 1]
     scalar_eqs = [b.eqs[0] for b in scalar]
+    block_of_col = np.full(len(unknowns), -1, dtype=np.int64)  # unknown -> its scalar block
+    block_of_col[[b.vars[0] for b in scalar]] = np.arange(len(scalar))
     solved, out.solution_column, position = solve_scalar_blocks(
         [res[e] for e in scalar_eqs], [sym[b.vars[0]] for b in scalar],
         {k for k, e in enumerate(scalar_eqs) if model.equations[e].terms > LONG_ROW},
         take(model.stacked_residuals(), scalar_eqs),
-        take(model.stacked_variables(), [unknowns[b.vars[0]] for b in scalar]))
-    explicit = {id(b): k for k, b in enumerate(scalar)}
+        take(model.stacked_variables(), [unknowns[b.vars[0]] for b in scalar]),
+        remap_rows([eq_cols[e] for e in scalar_eqs], block_of_col) if scalar else [])
     has_discrete = any(v.decl.kind == "discrete" for v in variables)
     var_hashes: set[int] = set()
+    assignments, positions = out.assignments, out.positions
+    k = -1                                      # position of the block among the scalar ones
     for block in blocks:
-        eqs, cols = list(block.eqs), list(block.vars)
+        eqs, cols = block.eqs, block.vars
         if has_discrete:
-            _check_discrete_loop(model, eqs, [unknowns[c] for c in cols], res)
+            _check_discrete_loop(model, list(eqs), [unknowns[c] for c in cols], res)
         if len(eqs) == 1:
-            k = explicit[id(block)]
+            k += 1
             expr = solved[k]
             if expr is not None:
-                out.assignments.append((unknowns[cols[0]], expr))
-                out.positions.append(position[k])
+                assignments.append((unknowns[cols[0]], expr))
+                positions.append(position[k])
                 out.n_explicit += 1
                 continue
             names = [variables[unknowns[cols[0]]].name]
@@ -136,7 +147,8 @@ def sort_equations(reduced: ReducedModel) -> SortedDAE:
         if not var_hashes:
             var_hashes.update(v.sx.element_hash() for v in variables)
         names = [variables[unknowns[c]].name for c in cols]
-        _loop(out, eqs, cols, eq_cols, res, sym, unknowns, names, variables, var_hashes)
+        _loop(out, list(eqs), list(cols), eq_cols, res, sym, unknowns, names, variables,
+              var_hashes)
     return out
 
 

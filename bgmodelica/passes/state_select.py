@@ -22,11 +22,17 @@ def _find(parent: list[int], a: int) -> int:
     return a
 
 
+def _extremes(variables) -> list[int]:
+    """Indices of the variables declared ALWAYS or NEVER (one attribute read each)."""
+    extreme = (StateSelect.ALWAYS, StateSelect.NEVER)
+    return [i for i, s in enumerate([getattr(v.decl, "state_select", 0) for v in variables])
+            if s in extreme]
+
+
 def check_alias_state_select(model: FlatModel) -> None:
     """Raise :class:`StateSelectError` when aliased variables have ALWAYS and NEVER."""
     variables = model.variables
-    marked = [i for i, v in enumerate(variables)
-              if v.state_select in (StateSelect.ALWAYS, StateSelect.NEVER)]
+    marked = _extremes(variables)
     if len(marked) < 2:
         return
     parent = list(range(len(variables)))
@@ -54,7 +60,8 @@ def check_states(reduced) -> None:
     """Raise :class:`StateSelectError` when the chosen states contradict ALWAYS / NEVER."""
     variables = reduced.model.variables
     states = set(reduced.states)
-    for j, v in enumerate(variables):
+    for j in _extremes(variables):
+        v = variables[j]
         if v.der_of >= 0:
             continue
         ss = v.state_select

@@ -128,11 +128,12 @@ def solve_linear_block(residuals: Sequence[ca.SX], vars_: Sequence[ca.SX],
 
 def solve_scalar_blocks(residuals: Sequence[ca.SX], vars_: Sequence[ca.SX],
                         long: set[int] | None = None, r_all: ca.SX | None = None,
-                        v_all: ca.SX | None = None) -> tuple[list[ca.SX | None], ca.SX,
-                                                             list[int]]:
+                        v_all: ca.SX | None = None, rows: Sequence[Sequence[int]] | None = None,
+                        ) -> tuple[list[ca.SX | None], ca.SX, list[int]]:
     """Solve each ``residuals[k] = 0`` for ``vars_[k]`` where it is linear in it (else None);
     ``long``: positions of long sums (see :func:`incidence`); ``r_all``/``v_all``: the same
-    residuals and variables already stacked, if the caller has them.
+    residuals and variables already stacked, if the caller has them; ``rows``: the incidence
+    of the residuals in ``vars_`` (by position), if the caller knows it.
 
     Vectorized: the pairs are colored so that no residual of a color depends on another
     variable of that color; then one Jacobian and one substitution per color give every
@@ -147,7 +148,9 @@ def solve_scalar_blocks(residuals: Sequence[ca.SX], vars_: Sequence[ca.SX],
     r_all = ca.vertcat(*residuals) if r_all is None else r_all
     v_all = ca.vertcat(*vars_) if v_all is None else v_all
     neighbours: list[set[int]] = [set() for _ in range(n)]
-    for i, row in enumerate(_incidence(residuals, vars_, r_all, v_all, long)):
+    if rows is None:
+        rows = _incidence(residuals, vars_, r_all, v_all, long)
+    for i, row in enumerate(rows):
         for j in row:
             if i != j:
                 neighbours[i].add(j)

@@ -30,6 +30,40 @@ def csr_incidence(rows: Sequence[Sequence[int]], n_cols: int) -> sp.csr_matrix:
     return sp.csr_matrix((np.ones(cols.size, dtype=np.int8), cols, indptr), shape=(n, n_cols))
 
 
+def remap_rows(rows: Sequence[Sequence[int]], mapping: Sequence[int] | np.ndarray
+               ) -> list[list[int]]:
+    """``sorted({mapping[j] for j in row})`` for every row, entries mapped to -1 dropped,
+    in numpy (a few hundredths of a microsecond per entry instead of one)."""
+    n = len(rows)
+    lengths = np.fromiter(map(len, rows), dtype=np.int64, count=n)
+    cols = np.fromiter(chain.from_iterable(rows), dtype=np.int64, count=int(lengths.sum()))
+    mapped = np.asarray(mapping, dtype=np.int64)[cols]
+    row_of = np.repeat(np.arange(n, dtype=np.int64), lengths)
+    keep = mapped >= 0
+    width = int(mapped.max()) + 1 if mapped.size else 1
+    keys = np.sort(row_of[keep] * width + mapped[keep])
+    keys = keys[np.concatenate(([True], keys[1:] != keys[:-1]))] if keys.size else keys
+    counts = np.bincount(keys // width, minlength=n)
+    flat = (keys % width).tolist()
+    ends = np.cumsum(counts).tolist()
+    starts = [0, *ends[:-1]]
+    return [flat[a:b] for a, b in zip(starts, ends, strict=True)]
+
+
+def derivative_bases(der_of: Sequence[int] | np.ndarray) -> np.ndarray:
+    """For each variable, the variable it is a (repeated) derivative of; itself if none.
+    ``der_of[j]`` is the variable ``j`` is the derivative of, -1 if none."""
+    der_of = np.asarray(der_of, dtype=np.int64)
+    base = np.arange(der_of.size, dtype=np.int64)
+    up = der_of.copy()
+    while True:
+        more = up >= 0
+        if not more.any():
+            return base
+        base[more] = up[more]
+        up = np.where(more, der_of[np.maximum(up, 0)], -1)
+
+
 def compiled_matching(rows: Sequence[Sequence[int]], n_cols: int) -> tuple[list[int], list[int]]:
     """A maximum matching ``(eq_to_var, var_to_eq)`` (-1: unmatched) by Hopcroft-Karp."""
     n = len(rows)

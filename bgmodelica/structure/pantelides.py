@@ -15,6 +15,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from .diagnosis import dulmage_mendelsohn
 from .errors import IndexReductionFailed, StructurallySingular
 from .graph import EquationGraph, derivative_chains, gc_paused
@@ -55,32 +57,36 @@ def _family_check(
     algorithm terminates. The highest-derivative matching is a valid warm start since each
     family has exactly one highest-derivative variable.
     """
-    fam_of_base = [-1] * graph.n_vars
-    families: list[int] = []
-    for j in range(graph.n_vars):
-        if var_order[j] == 0:
-            fam_of_base[j] = len(families)
-            families.append(j)
-    fam = [fam_of_base[b] for b in base]
+    families = np.flatnonzero(np.asarray(var_order, dtype=np.int64) == 0)
+    fam_of_base = np.full(graph.n_vars, -1, dtype=np.int64)
+    fam_of_base[families] = np.arange(families.size)
+    fam_arr = fam_of_base[np.asarray(base, dtype=np.int64)]
     active = graph.active_equations()
+    if len(active) == families.size:           # the warm start may already be perfect
+        start_vars = np.asarray(highest.eq_to_var, dtype=np.int64)[active]
+        if np.all(start_vars >= 0) and (not start_vars.size or np.bincount(
+                fam_arr[start_vars], minlength=families.size).max() == 1):
+            return
+    fam = fam_arr.tolist()
+    family_vars = families.tolist()
     eq_vars = graph.eq_vars
     fam_eqs = [[fam[v] for v in eq_vars[i]] for i in active]
-    start = Matching.empty(len(active), len(families))
+    start = Matching.empty(len(active), len(family_vars))
     for k, i in enumerate(active):
         v = highest.eq_to_var[i]
         if v != -1:
             start.eq_to_var[k] = fam[v]
             start.var_to_eq[fam[v]] = k
-    m = maximum_matching(fam_eqs, len(families), initial=start)
-    if m.size == len(active) == len(families):
+    m = maximum_matching(fam_eqs, len(family_vars), initial=start)
+    if m.size == len(active) == len(family_vars):
         return
-    dm = dulmage_mendelsohn(fam_eqs, len(families), m)
+    dm = dulmage_mendelsohn(fam_eqs, len(family_vars), m)
     raise StructurallySingular(
         None,
         overdetermined_eqs=sorted(active[i] for i in dm.overdetermined_eqs),
-        overdetermined_vars=sorted(families[k] for k in dm.overdetermined_vars),
+        overdetermined_vars=sorted(family_vars[k] for k in dm.overdetermined_vars),
         underdetermined_eqs=sorted(active[i] for i in dm.underdetermined_eqs),
-        underdetermined_vars=sorted(families[k] for k in dm.underdetermined_vars),
+        underdetermined_vars=sorted(family_vars[k] for k in dm.underdetermined_vars),
     )
 
 
