@@ -8,7 +8,13 @@ import random
 import pytest
 
 from bgmodelica.structure import block_lower_triangular, maximum_matching
-from bgmodelica.structure.compiled import LARGE, compiled_blocks, compiled_matching
+from bgmodelica.structure.compiled import (
+    LARGE,
+    compiled_blocks,
+    compiled_matching,
+    derivative_bases,
+    remap_rows,
+)
 
 
 def _square_system(n: int, extra: int, seed: int) -> list[list[int]]:
@@ -62,3 +68,22 @@ def test_large_systems_take_the_compiled_path() -> None:
     blocks = block_lower_triangular(rows, n, matching)
     assert [b.eqs for b in blocks] == [[i] for i in range(n)]
     assert [b.vars for b in blocks] == [[i] for i in range(n)]
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_remap_rows_equals_the_set_comprehension(seed: int) -> None:
+    rng = random.Random(seed)
+    n_in, n_out = 200, 60
+    rows = [[rng.randrange(n_in) for _ in range(rng.randint(0, 6))] for _ in range(150)]
+    mapping = [rng.randrange(-1, n_out) for _ in range(n_in)]
+    expected = [sorted({mapping[j] for j in row} - {-1}) for row in rows]
+    assert remap_rows(rows, mapping) == expected
+    assert remap_rows([], mapping) == []
+    assert remap_rows([[], []], mapping) == [[], []]
+
+
+def test_derivative_bases_follow_whole_chains() -> None:
+    # 0 <- der 3 <- der 5 (x, der(x), der(der(x))); 1 alone; 2 <- der 4
+    der_of = [-1, -1, -1, 0, 2, 3]
+    assert derivative_bases(der_of).tolist() == [0, 1, 2, 0, 2, 0]
+    assert derivative_bases([]).tolist() == []
