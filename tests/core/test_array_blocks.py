@@ -168,3 +168,25 @@ class Mismatch(Component):
 def test_block_of_mismatched_shapes_names_the_component():
     with pytest.raises(EquationError, match=r"top level \(Mismatch\).*shapes \(3,\) and \(2,\)"):
         bg.compile(Mismatch())
+
+
+class SwitchedDecay(Component):
+    """der(x) = -k*x with the gain k switched from 1 to 3 at t = 0.5 (a when-clause beside
+    the block equation): x_i(t) = x0_i*exp(-t) before, x0_i*exp(-0.5)*exp(-3(t-0.5)) after."""
+
+    x = Variable(shape=3, start=[1.0, 2.0, 4.0], fixed=True)
+    k = bg.Discrete(start=1.0, unit="1/s")
+
+    def equations(self):
+        yield der(self.x) == -self.k * self.x
+        yield bg.when(bg.time > 0.5, self.k == 3.0)
+
+
+def test_block_equation_in_a_hybrid_model():
+    eq = next(iter(SwitchedDecay().equations()))
+    assert isinstance(eq, ArrayEquation) and eq.is_block()
+    res = bg.simulate(SwitchedDecay(), stop_time=1.0, interval=0.05, **TIGHT)
+    t = res.time
+    ref = np.where(t <= 0.5, np.exp(-t), np.exp(-0.5) * np.exp(-3.0 * (t - 0.5)))
+    for k, x0 in enumerate([1.0, 2.0, 4.0]):
+        assert np.max(np.abs(res[f"x[{k + 1}]"] - x0 * ref)) < 1e-7
