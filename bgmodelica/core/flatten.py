@@ -191,13 +191,15 @@ class _Flattener:
         hybrid = self.draft is not None
         targets = self.draft.targets if hybrid else {}
         top_connectors = {id(c) for c in self.top._children.values() if isinstance(c, Connector)}
+        full_names, var_of = self.full, self.var_of
         for elem in self.elements:
             path = self.paths[id(elem)]
             owner = path if isinstance(elem, Component) else path.rpartition(".")[0]
+            prefix = f"{path}." if path else ""
             for sym in elem._symbols.values():
-                full = _join(path, sym.name)
+                full = prefix + sym.name
                 kind = sym.decl.kind
-                self.full[id(sym)] = full
+                full_names[id(sym)] = full
                 if hybrid:
                     if id(sym) in targets:
                         self.slot[id(sym)] = len(discretes)
@@ -212,13 +214,13 @@ class _Flattener:
                     inputs.append(FlatVariable(full, None, sym.decl, owner))
                 else:
                     below = len(variables)
-                    self.var_of[id(sym)] = below
+                    var_of[id(sym)] = below
                     symbols.append((sym, variables, below))
                     variables.append(FlatVariable(full, None, sym.decl, owner))
                     while sym.der is not None:             # derivative chain
                         sym, full = sym.der, f"der({full})"
                         variables[below].der = len(variables)
-                        self.var_of[id(sym)] = len(variables)
+                        var_of[id(sym)] = len(variables)
                         symbols.append((sym, variables, len(variables)))
                         variables.append(FlatVariable(full, None, sym.decl, owner, der_of=below))
                         below = len(variables) - 1
@@ -239,19 +241,20 @@ class _Flattener:
 
     def _bind(self, symbols) -> None:
         """Give every symbol an SX scalar: fresh ones become elements of one SX vector."""
-        fresh = [s for s, _, _ in symbols if s._sx is None]
-        old = [s for s, _, _ in symbols if s._sx is not None]
+        fresh = [entry for entry in symbols if entry[0]._sx is None]
+        old = [entry for entry in symbols if entry[0]._sx is not None]
         big = ca.SX.sym("v", len(fresh))
-        for sym, sx in zip(fresh, ca.vertsplit(big) if fresh else [], strict=True):
-            sym.bind(sx)
-        for k, sym in enumerate(fresh):
-            self.pos[id(sym)] = k
-        for k, sym in enumerate(old):
-            self.pos[id(sym)] = len(fresh) + k
-        self.pos[id(TIME)] = len(fresh) + len(old)
-        self.all_sx = ca.vertcat(big, *[s.sx for s in old], TIME.sx)
-        for sym, target, index in symbols:
-            target[index].sx = sym.sx
+        pos = self.pos
+        for k, ((sym, target, index), sx) in enumerate(
+                zip(fresh, ca.vertsplit(big) if fresh else [], strict=True)):
+            sym._sx = sx                        # Symbol.bind, without a call per symbol
+            target[index].sx = sx
+            pos[id(sym)] = k
+        for k, (sym, target, index) in enumerate(old, start=len(fresh)):
+            target[index].sx = sym._sx
+            pos[id(sym)] = k
+        pos[id(TIME)] = len(fresh) + len(old)
+        self.all_sx = ca.vertcat(big, *[entry[0]._sx for entry in old], TIME.sx)
 
     def _lower_binding(self, p: FlatVariable) -> FlatVariable:
         if isinstance(p.decl.value, Expr):

@@ -207,10 +207,6 @@ class Symbol:
             _REGISTRY[self._sx.element_hash()] = self
         return self._sx
 
-    def bind(self, sx: ca.SX) -> None:
-        """Use ``sx`` (an element of a flattening's symbol vector) as this symbol's SX."""
-        self._sx = sx
-
     def derivative(self) -> Symbol:
         """The symbol of this variable's time derivative (created once)."""
         if self.decl.kind == KIND_PARAMETER:
