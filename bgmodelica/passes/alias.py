@@ -23,30 +23,20 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
     if not links:
         return model
 
-    ranks: dict[int, tuple] = {}
-
-    def rank(i: int) -> tuple:
-        got = ranks.get(i)
-        if got is None:
-            v = variables[i]
-            got = ranks[i] = (v.der >= 0, v.state_select, bool(getattr(v.decl, "fixed", False)),
-                              -v.name.count("."), -len(v.name))
-        return got
-
-    classes = alias_classes(len(variables), links, lambda a, b: rank(a) > rank(b))
+    classes = alias_classes(len(variables), links, _ranks(variables, links))
     used = set(link_eqs) - {link_eqs[k] for k in classes.redundant}
 
     new_vars = list(variables)
-    _merge_metadata(new_vars, classes.rep, classes.sign)
+    members = [i for i, r in enumerate(classes.rep) if r != i]     # not representatives
+    _merge_metadata(new_vars, classes.rep, classes.sign, members)
     old: list[int] = []              # indices in new_vars (which extends variables)
     new_rep: list[int] = []
     new_sign: list[float] = []
     eliminated: set[int] = set()
     aliases = dict(model.aliases)
-    for i, v in enumerate(variables):
+    for i in members:
+        v = variables[i]
         r = classes.rep[i]
-        if r == i:
-            continue
         s = classes.sign[i]
         old.append(i)
         new_rep.append(r)
@@ -89,18 +79,37 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
     equations = [FlatEquation(res, eq.origin, terms=eq.terms)
                  for res, eq in zip(residuals, kept, strict=True)]
     keep_idx = [i for i in range(len(new_vars)) if i not in eliminated]
-    remap = {old_i: new_i for new_i, old_i in enumerate(keep_idx)}
+    remap = [-1] * (len(new_vars) + 1)           # old index -> new; remap[-1] stays -1
+    for new_i, old_i in enumerate(keep_idx):
+        remap[old_i] = new_i
     final = []
     for i in keep_idx:
         v = new_vars[i]
         if v.der < 0 and v.der_of < 0:
             final.append(v)                        # no derivative links to renumber
         else:
-            final.append(replace(v, der=remap.get(v.der, -1), der_of=remap.get(v.der_of, -1)))
+            final.append(FlatVariable(v.name, v.sx, v.decl, v.component,
+                                      der_of=remap[v.der_of], der=remap[v.der]))
     out = FlatModel(model.name, final, model.parameters, model.inputs, equations, aliases,
                     model.discretes, hybrid)
     out.initial_equations = initial if n_init else []
     out.remember_stacked(residuals=kept_column, variables=take(column, keep_idx), like=model)
+    return out
+
+
+def _ranks(variables: list[FlatVariable], links: list[tuple[int, int, float]]) -> list[int]:
+    """Integer ranks (higher: better representative of an alias class) of the linked
+    variables, by (has a derivative, state_select, fixed start, fewer dots, shorter name)."""
+    linked = {i for a, b, _ in links for i in (a, b)}
+    keys = {}
+    for i in linked:
+        v = variables[i]
+        keys[i] = (v.der >= 0, getattr(v.decl, "state_select", 0),
+                   bool(getattr(v.decl, "fixed", False)), -v.name.count("."), -len(v.name))
+    dense = {key: k for k, key in enumerate(sorted(set(keys.values())))}
+    out = [0] * len(variables)
+    for i, key in keys.items():
+        out[i] = dense[key]
     return out
 
 
@@ -116,12 +125,13 @@ def _ensure_derivative(variables: list[FlatVariable], i: int) -> int:
     return len(variables) - 1
 
 
-def _merge_metadata(variables: list[FlatVariable], rep: list[int], sign: list[float]) -> None:
-    """Carry fixed start values and the strongest state priority to each representative."""
-    for i, v in enumerate(list(variables)):
+def _merge_metadata(variables: list[FlatVariable], rep: list[int], sign: list[float],
+                    members: list[int]) -> None:
+    """Carry fixed start values and the strongest state priority to each representative
+    (``members``: the variables that are not their class's representative)."""
+    for i in members:
+        v = variables[i]
         r = rep[i]
-        if r == i:
-            continue
         rv = variables[r]
         dv, dr = v.decl, rv.decl
         updates = {}

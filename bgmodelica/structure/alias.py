@@ -6,7 +6,7 @@ member ``m`` satisfies ``m = sign[m] * r``. Pure integer work: no symbolic libra
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 
@@ -24,10 +24,11 @@ class AliasClasses:
 
 
 def alias_classes(n_vars: int, links: Iterable[tuple[int, int, float]],
-                  better: Callable[[int, int], bool]) -> AliasClasses:
+                  rank: Sequence[int]) -> AliasClasses:
     """Merge links ``(a, b, s)`` meaning ``var a = s * var b`` (``s`` is +1 or -1).
 
-    ``better(x, y)`` says whether ``x`` should represent a class rather than ``y``.
+    ``rank[x] > rank[y]`` says that ``x`` should represent a class rather than ``y``; on a
+    tie the root of ``b``'s class represents the merged class.
     """
     parent = list(range(n_vars))
     sign = [1.0] * n_vars            # v = sign[v] * parent[v]
@@ -54,7 +55,7 @@ def alias_classes(n_vars: int, links: Iterable[tuple[int, int, float]],
             continue
         # a = sa*ra, b = sb*rb, a = s*b  =>  ra = (s*sb/sa) * rb
         factor = s * sb / sa
-        if better(ra, rb):
+        if rank[ra] > rank[rb]:
             parent[rb], sign[rb] = ra, 1.0 / factor
         else:
             parent[ra], sign[ra] = rb, factor
