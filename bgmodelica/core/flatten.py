@@ -416,18 +416,14 @@ class _Flattener:
             self.columns.extend(r for r, _ in slow)
 
     def _lower(self, key, members) -> None:
-        n_leaves = len(members[0][0])
-        idx = [[0] * len(members) for _ in range(n_leaves)]
-        for m, (leaves, _, where, eq) in enumerate(members):
-            for k, sym in enumerate(leaves):
-                p = self.pos.get(id(sym))
-                if p is None:
-                    owner = getattr(sym, "owner", None)
-                    raise EquationError(
-                        f"{where}: equation {eq!r} uses {getattr(sym, 'name', sym)}"
-                        + (f" of {type(owner).__name__}" if owner is not None else "")
-                        + ", which is not part of the model (add its component to the model)")
-                idx[k][m] = p
+        get = self.pos.get
+        idx = [[get(id(sym)) for sym in column]       # leaf k of every member
+               for column in zip(*[m[0] for m in members], strict=True)]
+        for column in idx:
+            if None in column:
+                leaves, _, where, eq = members[column.index(None)]
+                sym = next(x for x in leaves if id(x) not in self.pos)
+                raise self._alien(sym, eq, where)
         leaf_vecs = [self.all_sx[col] for col in idx]
         const_vecs = []
         for k in range(len(members[0][1])):
@@ -441,11 +437,14 @@ class _Flattener:
         res = ca.SX(lhs - rhs)
         parts = ca.vertsplit(res) if len(members) > 1 else [res]
         signs = _alias_signs(shape_l, shape_r)
-        for r, (leaves, consts, where, _) in zip(parts, members, strict=True):
-            alias = None
-            if signs and not any(consts):
-                alias = self._alias_of(signs[0], leaves[0], signs[1], leaves[1])
-            self.equations.append(FlatEquation(r, where, alias))
+        if signs:
+            for r, (leaves, consts, where, _) in zip(parts, members, strict=True):
+                alias = None if any(consts) else \
+                    self._alias_of(signs[0], leaves[0], signs[1], leaves[1])
+                self.equations.append(FlatEquation(r, where, alias))
+        else:
+            self.equations.extend(FlatEquation(r, m[2]) for r, m in zip(parts, members,
+                                                                        strict=True))
         self.columns.append(res)
 
     def _lower_block(self, eq: ArrayEquation, where: str) -> None:
