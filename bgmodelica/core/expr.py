@@ -299,6 +299,29 @@ def lower_group(shape: Any, leaf_vectors: list, const_vectors: list) -> Any:
     return go(shape)
 
 
+def alias_signs(shape_l: Any, shape_r: Any) -> tuple[float, ...]:
+    """For an equation shape ``lhs == rhs`` made of sums and negations of two leaves and
+    constants: the signs ``(sa, sb)`` of the leaves (the equation is the alias link
+    ``sa*a + sb*b = 0`` when its constants are all 0); ``()`` for any other shape."""
+    signs: list[float] = []
+
+    def walk(s: Any, sign: float) -> bool:
+        if s == "L":
+            signs.append(sign)
+            return len(signs) <= 2
+        if s == "C":
+            return True
+        if s[0] == "neg":
+            return walk(s[1], -sign)
+        if s[0] in ("+", "-"):
+            return walk(s[1], sign) and walk(s[2], sign if s[0] == "+" else -sign)
+        return False
+
+    if walk(shape_l, 1.0) and walk(shape_r, -1.0) and len(signs) == 2:
+        return (signs[0], signs[1])
+    return ()
+
+
 # -- symbolic time derivative -------------------------------------------------------------------
 
 

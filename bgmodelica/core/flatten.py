@@ -16,12 +16,11 @@ from dataclasses import replace
 from typing import Any
 
 import casadi as ca
-import numpy as np
 
 from ..errors import ConnectError, DeclarationError, EquationError
 from ..validate import check_binding, check_sx_binding, guarded_equations
-from . import flatten_hybrid
-from .arrays import ArrayEquation, ArrayExpr
+from . import flatten_arrays, flatten_hybrid
+from .arrays import ArrayEquation
 from .component import Component, Connection, Connector, Element
 from .expr import (
     HYBRID_NODES,
@@ -29,7 +28,7 @@ from .expr import (
     Expr,
     Leaf,
     Number,
-    apply_op,
+    alias_signs,
     lower_group,
     shape_of,
     to_sx,
@@ -436,7 +435,7 @@ class _Flattener:
         rhs = lower_group(shape_r, leaf_vecs[n_l:], const_vecs[c_l:])
         res = ca.SX(lhs - rhs)
         parts = ca.vertsplit(res) if len(members) > 1 else [res]
-        signs = _alias_signs(shape_l, shape_r)
+        signs = alias_signs(shape_l, shape_r)
         if signs:
             for r, (leaves, consts, where, _) in zip(parts, members, strict=True):
                 alias = None if any(consts) else \
@@ -448,55 +447,17 @@ class _Flattener:
         self.columns.append(res)
 
     def _lower_block(self, eq: ArrayEquation, where: str) -> None:
-        """One array equation as one residual column: leaves are slices of the model's
-        symbol vector, operators act on whole vectors (numpy broadcasting by index)."""
-        shape = eq.shape
-        size = int(np.prod(shape))
-        found: list[bool] = []
-        res = ca.SX(self._block(eq.lhs, shape, eq, where, found)
-                    - self._block(eq.rhs, shape, eq, where, found))
-        if not found:
-            raise EquationError(f"{where}: equation {eq!r} has no variables")
-        if res.numel() != size:
-            res = ca.repmat(res, size, 1)
+        """One array equation as one residual column (:mod:`.flatten_arrays`)."""
+        res, size = flatten_arrays.residual(eq, where, self.pos, self.all_sx, self._alien)
         parts = ca.vertsplit(res) if size > 1 else [res]
-        links = self._block_aliases(eq, shape)
-        if links is None:
+        pairs = flatten_arrays.alias_pairs(eq)
+        if pairs is None:
             self.equations.extend(FlatEquation(r, where) for r in parts)
         else:
-            self.equations.extend(FlatEquation(r, where, a)
-                                  for r, a in zip(parts, links, strict=True))
+            sa, sb, a, b = pairs
+            self.equations.extend(FlatEquation(r, where, self._alias_of(sa, la.sym, sb, lb.sym))
+                                  for r, la, lb in zip(parts, a, b, strict=True))
         self.columns.append(res)
-
-    def _block(self, x: Any, shape: tuple[int, ...], eq: ArrayEquation, where: str,
-               found: list[bool]) -> Any:
-        """``x`` lowered to a column of ``prod(shape)`` elements (C order) or a scalar."""
-        if isinstance(x, ArrayExpr):
-            if x.node is None:
-                items = x.items.ravel()
-                pos = self.pos
-                try:
-                    idx = [pos[id(leaf.sym)] for leaf in items]
-                except KeyError:
-                    sym = next(leaf.sym for leaf in items if id(leaf.sym) not in pos)
-                    raise self._alien(sym, eq, where) from None
-                found.append(True)
-                col = self.all_sx[idx]
-            else:
-                op, args = x.node
-                col = apply_op(op, [self._block(a, x.shape, eq, where, found) for a in args])
-            return _broadcast(col, x.shape, shape)
-        if isinstance(x, np.ndarray):
-            return ca.DM(np.broadcast_to(x.astype(float), shape).ravel())
-        if isinstance(x, Expr):
-            leaves: list = []
-            shape_of(x, leaves, [])
-            for sym in leaves:
-                if id(sym) not in self.pos:
-                    raise self._alien(sym, eq, where)
-            found.extend(True for _ in leaves[:1])
-            return to_sx(x)
-        return float(x)
 
     def _alien(self, sym: Any, eq: Any, where: str) -> EquationError:
         owner = getattr(sym, "owner", None)
@@ -504,19 +465,6 @@ class _Flattener:
             f"{where}: equation {eq!r} uses {getattr(sym, 'name', sym)}"
             + (f" of {type(owner).__name__}" if owner is not None else "")
             + ", which is not part of the model (add its component to the model)")
-
-    def _block_aliases(self, eq: ArrayEquation, shape: tuple[int, ...]) -> list | None:
-        """Per element, the alias link of an array equation ``a == b``, ``a == -b``,
-        ``a + b == 0``... between two arrays of variables; None for any other form."""
-        leaves: list = []
-        consts: list = []
-        signs = _alias_signs(_block_shape(eq.lhs, leaves, consts),
-                             _block_shape(eq.rhs, leaves, consts))
-        if not signs or any(np.any(np.asarray(c) != 0.0) for c in consts):
-            return None
-        a, b = (np.broadcast_to(arr.items, shape).ravel() for arr in leaves)
-        sa, sb = signs
-        return [self._alias_of(sa, la.sym, sb, lb.sym) for la, lb in zip(a, b, strict=True)]
 
     def _alias_of(self, sa: float, a: Any, sb: float, b: Any) -> tuple[int, int, float] | None:
         """``sa*a + sb*b = 0`` as the alias link ``a = -sb/sa * b``, if both are variables."""
@@ -589,51 +537,6 @@ def _count_consts(shape: Any) -> int:
     if shape == "L":
         return 0
     return sum(_count_consts(a) for a in shape[1:])
-
-
-def _block_shape(x: Any, leaves: list, consts: list) -> Any:
-    """The shape of an array expression for :func:`_alias_signs`: stored arrays are leaves
-    ``"L"``, numbers and numeric arrays constants ``"C"``, scalar expressions ``"X"``."""
-    if isinstance(x, ArrayExpr):
-        if x.node is None:
-            leaves.append(x)
-            return "L"
-        return (x.node[0], *[_block_shape(a, leaves, consts) for a in x.node[1]])
-    if isinstance(x, Expr):
-        return "X"
-    consts.append(x)
-    return "C"
-
-
-def _broadcast(col: Any, have: tuple[int, ...], want: tuple[int, ...]) -> Any:
-    """A column of shape ``have`` (C order) repeated to ``want`` by numpy broadcasting."""
-    if have == want or int(np.prod(have)) == 1:
-        return col
-    idx = np.broadcast_to(np.arange(int(np.prod(have))).reshape(have), want).ravel()
-    return col[idx.tolist()]
-
-
-def _alias_signs(shape_l: Any, shape_r: Any) -> tuple[float, ...]:
-    """For an equation shape ``lhs == rhs`` made of sums and negations of two leaves and
-    constants: the signs ``(sa, sb)`` of the leaves (the equation is the alias link
-    ``sa*a + sb*b = 0`` when its constants are all 0); ``()`` for any other shape."""
-    signs: list[float] = []
-
-    def walk(s: Any, sign: float) -> bool:
-        if s == "L":
-            signs.append(sign)
-            return len(signs) <= 2
-        if s == "C":
-            return True
-        if s[0] == "neg":
-            return walk(s[1], -sign)
-        if s[0] in ("+", "-"):
-            return walk(s[1], sign) and walk(s[2], sign if s[0] == "+" else -sign)
-        return False
-
-    if walk(shape_l, 1.0) and walk(shape_r, -1.0) and len(signs) == 2:
-        return (signs[0], signs[1])
-    return ()
 
 
 def _leaf_symbols(e: Any) -> list:

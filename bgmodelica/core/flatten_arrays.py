@@ -1,0 +1,102 @@
+"""Array equations lowered as blocks (see :mod:`.arrays`).
+
+An array equation becomes one residual column: its arrays of declared scalars are slices of
+the model's symbol vector (by position), every operator is one CasADi operation on whole
+vectors, and numpy broadcasting is an index map. ``a == b``, ``a == -b``, ``a + b == 0``
+between two arrays of variables are alias links, element by element.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from ..errors import EquationError
+from .arrays import ArrayEquation, ArrayExpr
+from .expr import Expr, alias_signs, apply_op, shape_of, to_sx
+
+#: ``alien(symbol, equation, where)``: the error for a symbol that is not part of the model
+Alien = Callable[[Any, Any, str], EquationError]
+
+
+def residual(eq: ArrayEquation, where: str, pos: dict[int, int], symbols: ca.SX,
+             alien: Alien) -> tuple[ca.SX, int]:
+    """``lhs - rhs`` of ``eq`` as one column of its scalar equations (C order) and their
+    number; ``pos`` maps ``id(symbol)`` to its row in ``symbols``."""
+    shape = eq.shape
+    size = int(np.prod(shape))
+    found: list[bool] = []
+
+    def lower(x: Any, want: tuple[int, ...]) -> Any:
+        if isinstance(x, ArrayExpr):
+            if x.node is None:
+                items = x.items.ravel()
+                try:
+                    idx = [pos[id(leaf.sym)] for leaf in items]
+                except KeyError:
+                    sym = next(leaf.sym for leaf in items if id(leaf.sym) not in pos)
+                    raise alien(sym, eq, where) from None
+                found.append(True)
+                col = symbols[idx]
+            else:
+                op, args = x.node
+                col = apply_op(op, [lower(a, x.shape) for a in args])
+            return _broadcast(col, x.shape, want)
+        if isinstance(x, np.ndarray):
+            return ca.DM(np.broadcast_to(x.astype(float), want).ravel())
+        if isinstance(x, Expr):
+            leaves: list = []
+            shape_of(x, leaves, [])
+            for sym in leaves:
+                if id(sym) not in pos:
+                    raise alien(sym, eq, where)
+            found.extend(True for _ in leaves[:1])
+            return to_sx(x)
+        return float(x)
+
+    res = ca.SX(lower(eq.lhs, shape) - lower(eq.rhs, shape))
+    if not found:
+        raise EquationError(f"{where}: equation {eq!r} has no variables")
+    if res.numel() != size:
+        res = ca.repmat(res, size, 1)
+    return res, size
+
+
+def alias_pairs(eq: ArrayEquation) -> tuple[float, float, np.ndarray, np.ndarray] | None:
+    """For ``sa*a + sb*b = 0`` between two arrays of declared scalars (after moving all to
+    one side): ``(sa, sb, leaves of a, leaves of b)``, broadcast to the equation's shape and
+    flattened; None for any other form."""
+    leaves: list = []
+    consts: list = []
+    signs = alias_signs(_signature(eq.lhs, leaves, consts), _signature(eq.rhs, leaves, consts))
+    if not signs or any(np.any(np.asarray(c) != 0.0) for c in consts):
+        return None
+    shape = eq.shape
+    a, b = (np.broadcast_to(arr.items, shape).ravel() for arr in leaves)
+    return signs[0], signs[1], a, b
+
+
+def _signature(x: Any, leaves: list, consts: list) -> Any:
+    """The shape of an array expression for :func:`~.expr.alias_signs`: stored arrays are
+    leaves ``"L"``, numbers and numeric arrays constants ``"C"``, scalar expressions
+    ``"X"``."""
+    if isinstance(x, ArrayExpr):
+        if x.node is None:
+            leaves.append(x)
+            return "L"
+        return (x.node[0], *[_signature(a, leaves, consts) for a in x.node[1]])
+    if isinstance(x, Expr):
+        return "X"
+    consts.append(x)
+    return "C"
+
+
+def _broadcast(col: Any, have: tuple[int, ...], want: tuple[int, ...]) -> Any:
+    """A column of shape ``have`` (C order) repeated to ``want`` by numpy broadcasting."""
+    if have == want or int(np.prod(have)) == 1:
+        return col
+    idx = np.broadcast_to(np.arange(int(np.prod(have))).reshape(have), want).ravel()
+    return col[idx.tolist()]
