@@ -22,7 +22,15 @@ from typing import Any
 
 import numpy as np
 
-from .errors import DeclarationError, OptionError, ParameterError, UserCodeError
+from .errors import (
+    ConnectError,
+    DeclarationError,
+    EquationError,
+    ModelError,
+    OptionError,
+    ParameterError,
+    UserCodeError,
+)
 
 #: output grids with more points than this are refused whatever the memory
 MAX_OUTPUT_POINTS = 50_000_000
@@ -487,33 +495,26 @@ def check_export_args(args: Any) -> None:
 
 # -- model building --------------------------------------------------------------------------
 
-def guarded_equations(elem: Any, where: str, path: str, blocks: bool = False):
-    """``elem.all_equations(blocks)``, with an exception raised by the user's ``equations()``
-    turned into a :class:`UserCodeError` naming the component ``where`` and the user's file
-    and line, and model errors raised there prefixed with ``where``."""
-    from .errors import ConnectError, EquationError, ModelError
-
-    it = iter(elem.all_equations(blocks))
-    while True:
+def guarded_equations(elem: Any, where: str, path: str, blocks: bool = False) -> list[Any]:
+    """``list(elem.all_equations(blocks))``, with an exception raised by the user's
+    ``equations()`` turned into a :class:`UserCodeError` naming the component ``where`` and
+    the user's file and line, and model errors raised there prefixed with ``where``."""
+    try:
+        return list(elem.all_equations(blocks))
+    except UserCodeError:
+        raise
+    except (ConnectError, DeclarationError, EquationError) as err:
+        if str(err).startswith(where):
+            raise
         try:
-            eq = next(it)
-        except StopIteration:
-            return
-        except UserCodeError:
-            raise
-        except (ConnectError, DeclarationError, EquationError) as err:
-            if str(err).startswith(where):
-                raise
-            try:
-                again = type(err)(f"{where}: {err}")
-            except TypeError:
-                raise err from None
-            raise again from None
-        except ModelError:
-            raise
-        except Exception as err:  # noqa: BLE001 -- user code: say where, no traceback
-            raise user_error(err, f"{where}: equations()", path) from err
-        yield eq
+            again = type(err)(f"{where}: {err}")
+        except TypeError:
+            raise err from None
+        raise again from None
+    except ModelError:
+        raise
+    except Exception as err:  # noqa: BLE001 -- user code: say where, no traceback
+        raise user_error(err, f"{where}: equations()", path) from err
 
 
 def check_binding(name: str, value: Any, leaves: list, full: dict[int, str]) -> None:

@@ -98,22 +98,26 @@ class Element:
 
     @_gc_paused_init
     def __init__(self, name: str | None = None, **modifiers: Any) -> None:
-        object.__setattr__(self, "_name", name)
-        object.__setattr__(self, "_symbols", {})
-        object.__setattr__(self, "_children", {})
-        object.__setattr__(self, "_equations", [])
-        nested = {k: v for k, v in modifiers.items() if "." in k}
-        local = {k: v for k, v in modifiers.items() if "." not in k}
+        symbols: dict[str, Symbol] = {}
+        attrs = self.__dict__
+        attrs["_name"] = name
+        attrs["_symbols"] = symbols
+        attrs["_children"] = {}
+        attrs["_equations"] = []
+        nested = {k: v for k, v in modifiers.items() if "." in k} if modifiers else {}
+        local = {k: v for k, v in modifiers.items() if "." not in k} if modifiers else {}
         for key, decl in type(self)._declarations.items():
             if decl.shape != ():
                 self._declare_array(key, decl, local.pop(key, None))
                 continue
-            if key in local:
+            if local and key in local:
                 decl = decl.with_start(local.pop(key))
-            self._declare_scalar(key, decl)
+            sym = Symbol(key, decl, self)          # _declare_scalar, inlined: hot path
+            symbols[key] = sym
+            attrs[key] = sym.leaf
         for key, template in type(self)._templates.items():
             child = _build_child(key, template)
-            if key in local:
+            if local and key in local:
                 child.modify(**_as_modifiers(key, local.pop(key)))
             self.add(key, child)
         if local:
@@ -336,6 +340,8 @@ def _describe(x: Any) -> str:
 def check_connectable(a: Any, b: Any) -> None:
     """Raise :class:`ConnectError` unless ``a`` and ``b`` may be connected."""
     if isinstance(a, Connector) and isinstance(b, Connector):
+        if type(a) is type(b) and _same_declarations(a, b):
+            return
         sa, sb = a.signature(), b.signature()
         for name in sa.keys() & sb.keys():
             if sa[name] != sb[name] and {sa[name], sb[name]} != {KIND_INPUT, KIND_OUTPUT}:
@@ -369,6 +375,22 @@ def check_connectable(a: Any, b: Any) -> None:
     if kinds == {KIND_OUTPUT}:
         raise ConnectError(f"cannot connect two outputs: {_qualified(syms[0])} and "
                            f"{_qualified(syms[1])} (an output is connected to inputs)")
+
+
+def _same_declarations(a: Connector, b: Connector) -> bool:
+    """Whether two connectors declare the same variables with the same kinds and units
+    (the common case, two instances of one class, checked without building signatures)."""
+    sa, sb = a._symbols, b._symbols
+    if len(sa) != len(sb):
+        return False
+    for name, sym in sa.items():
+        other = sb.get(name)
+        if other is None:
+            return False
+        da, db = sym.decl, other.decl
+        if da is not db and (da.kind != db.kind or da.unit != db.unit):
+            return False
+    return True
 
 
 def _as_array(x: Any) -> Any:
@@ -409,12 +431,10 @@ class Component(Element):
     def all_initial_equations(self) -> Iterator[Any]:
         """Initial equations of every class in the hierarchy (base classes first), then
         added ones."""
-        for cls in reversed(type(self).__mro__):
-            own = vars(cls).get("initial_equations")
-            if own is not None:
-                result = own(self)
-                if result is not None:
-                    yield from result
+        for own in _own_methods(type(self), "initial_equations"):
+            result = own(self)
+            if result is not None:
+                yield from result
         yield from self.__dict__.get("_initial_equations", ())
 
     def connect(self, a: Any, b: Any) -> None:
@@ -433,21 +453,32 @@ class Component(Element):
         """Equations of every class in the hierarchy (base classes first), then added ones;
         array equations and lists of connections come out as their scalar items (with
         ``blocks``, array equations that flattening lowers whole stay whole)."""
-        for cls in reversed(type(self).__mro__):
-            own = vars(cls).get("equations")
-            if own is not None:
-                result = own(self)
-                if result is not None:
-                    for item in result:
-                        if isinstance(item, (ArrayEquation, list)):
-                            yield from _scalar_items(item, blocks)
-                        else:
-                            yield item
+        for own in _own_methods(type(self), "equations"):
+            result = own(self)
+            if result is not None:
+                for item in result:
+                    if isinstance(item, (ArrayEquation, list)):
+                        yield from _scalar_items(item, blocks)
+                    else:
+                        yield item
         for item in self._equations:
             if isinstance(item, (ArrayEquation, list)):
                 yield from _scalar_items(item, blocks)
             else:
                 yield item
+
+
+_OWN_METHODS: dict[tuple[type, str], tuple[Callable[..., Any], ...]] = {}
+
+
+def _own_methods(cls: type, name: str) -> tuple[Callable[..., Any], ...]:
+    """The methods ``name`` defined by ``cls`` and its bases, base classes first."""
+    found = _OWN_METHODS.get((cls, name))
+    if found is None:
+        found = _OWN_METHODS[cls, name] = tuple(
+            own for klass in reversed(cls.__mro__)
+            if (own := vars(klass).get(name)) is not None)
+    return found
 
 
 def _scalar_items(item: Any, blocks: bool = False) -> Iterator[Any]:

@@ -10,7 +10,7 @@ import casadi as ca
 from .variables import Declaration, StateSelect
 
 
-@dataclass
+@dataclass(slots=True)
 class FlatVariable:
     """One scalar of the flat model.
 
@@ -37,7 +37,7 @@ class FlatVariable:
         return getattr(self.decl, "state_select", StateSelect.DEFAULT)
 
 
-@dataclass
+@dataclass(slots=True)
 class FlatEquation:
     """A residual equation ``residual == 0`` and where it came from.
 

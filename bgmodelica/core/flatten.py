@@ -74,29 +74,35 @@ class _Flattener:
     # -- tree walk -------------------------------------------------------------------------
     def run(self, name: str) -> FlatModel:
         stack: list[tuple[Element, str, Element | None]] = [(self.top, "", None)]
+        paths, parents, elements = self.paths, self.parents, self.elements
+        connections, pending = self.connections, self.pending
         while stack:
             elem, path, parent = stack.pop()
-            if id(elem) in self.paths:
+            key = id(elem)
+            if key in paths:
                 raise DeclarationError(
                     f"{type(elem).__name__} instance is used twice in the model, as "
-                    f"{self.paths[id(elem)] or 'top'} and {path}: create one instance per use")
-            self.paths[id(elem)] = path
+                    f"{paths[key] or 'top'} and {path}: create one instance per use")
+            paths[key] = path
             if parent is not None:
-                self.parents[id(elem)] = parent
-            self.elements.append(elem)
+                parents[key] = parent
+            elements.append(elem)
             if isinstance(elem, Component):
                 for eq in guarded_equations(elem, self.where(elem), path, blocks=True):
                     if isinstance(eq, Connection):
-                        self.connections.append((eq, elem))
+                        connections.append((eq, elem))
                     else:
-                        self.pending.append((eq, elem))
-            for child_name, child in reversed(list(elem._children.items())):
-                stack.append((child, _join(path, child_name), elem))
+                        pending.append((eq, elem))
+            children = elem._children
+            if children:
+                prefix = f"{path}." if path else ""
+                stack.extend((child, prefix + child_name, elem)
+                             for child_name, child in reversed(children.items()))
         if HYBRID_NODES[0]:
             self.pending, draft = flatten_hybrid.extract(self.pending, self.where)
             self.draft = None if draft.empty else draft
         variables, parameters, inputs, discretes, symbols = self._collect_symbols()
-        self._bind(symbols)
+        positions = self._bind(symbols)
         self._connection_equations()
         self._component_equations()
         initial = self._initial_equations()
@@ -112,8 +118,7 @@ class _Flattener:
                          discretes=discretes, hybrid=hybrid, sources=sources,
                          initial_equations=initial)
         flat.remember_stacked(ca.vertcat(*self.columns) if self.columns else None,
-                              *[take(self.all_sx, [self.pos[id(sym)] for sym, target, _ in symbols
-                                                   if target is kind])
+                              *[take(self.all_sx, positions.get(id(kind), []))
                                 for kind in (variables, declared)])
         return flat
 
@@ -190,32 +195,33 @@ class _Flattener:
         hybrid = self.draft is not None
         targets = self.draft.targets if hybrid else {}
         top_connectors = {id(c) for c in self.top._children.values() if isinstance(c, Connector)}
-        full_names, var_of = self.full, self.var_of
+        full_names, var_of, paths = self.full, self.var_of, self.paths
+        add_symbol, add_variable = symbols.append, variables.append
         for elem in self.elements:
-            path = self.paths[id(elem)]
+            path = paths[id(elem)]
             owner = path if isinstance(elem, Component) else path.rpartition(".")[0]
             prefix = f"{path}." if path else ""
+            top_level = elem is self.top or id(elem) in top_connectors
             for sym in elem._symbols.values():
                 full = prefix + sym.name
-                kind = sym.decl.kind
+                decl = sym.decl
+                kind = decl.kind
                 full_names[id(sym)] = full
-                if hybrid:
-                    if id(sym) in targets:
-                        self.slot[id(sym)] = len(discretes)
-                        symbols.append((sym, discretes, len(discretes)))
-                        discretes.append(FlatVariable(full, None, sym.decl, owner))
-                        continue
-                if kind == KIND_PARAMETER:
-                    symbols.append((sym, parameters, len(parameters)))
-                    parameters.append(FlatVariable(full, None, sym.decl, owner))
-                elif kind == KIND_INPUT and (elem is self.top or id(elem) in top_connectors):
-                    symbols.append((sym, inputs, len(inputs)))
-                    inputs.append(FlatVariable(full, None, sym.decl, owner))
+                if hybrid and id(sym) in targets:
+                    self.slot[id(sym)] = len(discretes)
+                    add_symbol((sym, discretes, len(discretes)))
+                    discretes.append(FlatVariable(full, None, decl, owner))
+                elif kind == KIND_PARAMETER:
+                    add_symbol((sym, parameters, len(parameters)))
+                    parameters.append(FlatVariable(full, None, decl, owner))
+                elif kind == KIND_INPUT and top_level:
+                    add_symbol((sym, inputs, len(inputs)))
+                    inputs.append(FlatVariable(full, None, decl, owner))
                 else:
                     below = len(variables)
                     var_of[id(sym)] = below
-                    symbols.append((sym, variables, below))
-                    variables.append(FlatVariable(full, None, sym.decl, owner))
+                    add_symbol((sym, variables, below))
+                    add_variable(FlatVariable(full, None, decl, owner))
                     while sym.der is not None:             # derivative chain
                         sym, full = sym.der, f"der({full})"
                         variables[below].der = len(variables)
@@ -238,22 +244,35 @@ class _Flattener:
                 discretes.append(FlatVariable(name, None, sym.decl, ""))
         return variables, parameters, inputs, discretes, symbols
 
-    def _bind(self, symbols) -> None:
-        """Give every symbol an SX scalar: fresh ones become elements of one SX vector."""
+    def _bind(self, symbols) -> dict[int, list[int]]:
+        """Give every symbol an SX scalar: fresh ones become elements of one SX vector.
+        Returns id(target list) -> the positions in ``self.all_sx`` of its symbols, in order."""
         fresh = [entry for entry in symbols if entry[0]._sx is None]
         old = [entry for entry in symbols if entry[0]._sx is not None]
         big = ca.SX.sym("v", len(fresh))
         pos = self.pos
+        positions: dict[int, list[int]] = {}
+        last, column = None, []
         for k, ((sym, target, index), sx) in enumerate(
                 zip(fresh, ca.vertsplit(big) if fresh else [], strict=True)):
             sym._sx = sx                        # Symbol.bind, without a call per symbol
             target[index].sx = sx
             pos[id(sym)] = k
+            if target is not last:
+                last = target
+                if id(target) not in positions:
+                    positions[id(target)] = [0] * len(target)
+                column = positions[id(target)]
+            column[index] = k
         for k, (sym, target, index) in enumerate(old, start=len(fresh)):
             target[index].sx = sym._sx
             pos[id(sym)] = k
+            if id(target) not in positions:
+                positions[id(target)] = [0] * len(target)
+            positions[id(target)][index] = k
         pos[id(TIME)] = len(fresh) + len(old)
         self.all_sx = ca.vertcat(big, *[entry[0]._sx for entry in old], TIME.sx)
+        return positions
 
     def _lower_binding(self, p: FlatVariable) -> FlatVariable:
         if isinstance(p.decl.value, Expr):
@@ -551,8 +570,4 @@ def _hidden_name(sym: Symbol, k: int) -> str:
     if sym.name.endswith("()"):
         return sym.name
     return f"${sym.name}{k}"
-
-
-def _join(path: str, name: str) -> str:
-    return f"{path}.{name}" if path else name
 
