@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 import casadi as ca
+import numpy as np
 
 from ..core.flatmodel import FlatEquation, FlatModel, FlatVariable, take
 from ..core.variables import Variable, derivative_unit
@@ -27,13 +28,23 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
     used = set(link_eqs) - {link_eqs[k] for k in classes.redundant}
 
     new_vars = list(variables)
-    members = [i for i, r in enumerate(classes.rep) if r != i]     # not representatives
+    rep_of = np.asarray(classes.rep)
+    members = np.flatnonzero(rep_of != np.arange(len(rep_of))).tolist()   # not representatives
     _merge_metadata(new_vars, classes.rep, classes.sign, members)
     old: list[int] = []              # indices in new_vars (which extends variables)
     new_rep: list[int] = []
     new_sign: list[float] = []
     eliminated: set[int] = set()
     aliases = dict(model.aliases)
+    if not any(variables[i].der >= 0 for i in members):      # no derivative chains
+        old = members
+        new_rep = rep_of[members].tolist()
+        new_sign = [classes.sign[i] for i in members]
+        eliminated = set(members)
+        aliases.update(zip([variables[i].name for i in members],
+                           zip([variables[r].name for r in new_rep], new_sign, strict=True),
+                           strict=True))
+        members = []
     for i in members:
         v = variables[i]
         r = classes.rep[i]
@@ -56,7 +67,7 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
 
     column = ca.vertcat(model.stacked_variables(),     # symbols of new_vars, by index
                         *[v.sx for v in new_vars[len(variables):]])
-    kept_idx = [k for k in range(len(model.equations)) if k not in used]
+    kept_idx = _complement(len(model.equations), used)
     kept = [model.equations[k] for k in kept_idx]
     residuals: list[ca.SX] = []
     kept_column = None
@@ -78,10 +89,10 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
             hybrid = hybrid.with_expressions(parts[len(kept) + n_init:])
     equations = [FlatEquation(res, eq.origin, terms=eq.terms)
                  for res, eq in zip(residuals, kept, strict=True)]
-    keep_idx = [i for i in range(len(new_vars)) if i not in eliminated]
-    remap = [-1] * (len(new_vars) + 1)           # old index -> new; remap[-1] stays -1
-    for new_i, old_i in enumerate(keep_idx):
-        remap[old_i] = new_i
+    keep_idx = _complement(len(new_vars), eliminated)
+    remap_of = np.full(len(new_vars) + 1, -1)    # old index -> new; remap[-1] stays -1
+    remap_of[keep_idx] = np.arange(len(keep_idx))
+    remap = remap_of.tolist()
     final = []
     for i in keep_idx:
         v = new_vars[i]
@@ -97,20 +108,25 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
     return out
 
 
+def _complement(n: int, removed: set[int]) -> list[int]:
+    """``[k for k in range(n) if k not in removed]``, in numpy."""
+    keep = np.ones(n, dtype=bool)
+    keep[np.fromiter(removed, dtype=np.int64, count=len(removed))] = False
+    return np.flatnonzero(keep).tolist()
+
+
 def _ranks(variables: list[FlatVariable], links: list[tuple[int, int, float]]) -> list[int]:
     """Integer ranks (higher: better representative of an alias class) of the linked
-    variables, by (has a derivative, state_select, fixed start, fewer dots, shorter name)."""
-    linked = {i for a, b, _ in links for i in (a, b)}
-    keys = {}
-    for i in linked:
-        v = variables[i]
-        keys[i] = (v.der >= 0, getattr(v.decl, "state_select", 0),
-                   bool(getattr(v.decl, "fixed", False)), -v.name.count("."), -len(v.name))
-    dense = {key: k for k, key in enumerate(sorted(set(keys.values())))}
-    out = [0] * len(variables)
-    for i, key in keys.items():
-        out[i] = dense[key]
-    return out
+    variables, by (has a derivative, state_select, fixed start, fewer dots, shorter name):
+    dense ranks of those keys in lexicographic order (0 for variables in no link)."""
+    ends = np.array([(a, b) for a, b, _ in links], dtype=np.int64)
+    linked = np.unique(ends).tolist()
+    keys = np.array([(v.der >= 0, int(getattr(v.decl, "state_select", 0)),
+                      bool(getattr(v.decl, "fixed", False)), -v.name.count("."), -len(v.name))
+                     for v in map(variables.__getitem__, linked)], dtype=np.int64)
+    out = np.zeros(len(variables), dtype=np.int64)
+    out[linked] = np.unique(keys, axis=0, return_inverse=True)[1].ravel()
+    return out.tolist()
 
 
 def _ensure_derivative(variables: list[FlatVariable], i: int) -> int:

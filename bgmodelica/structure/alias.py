@@ -34,7 +34,7 @@ def alias_classes(n_vars: int, links: Iterable[tuple[int, int, float]],
     sign = [1.0] * n_vars            # v = sign[v] * parent[v]
     redundant: list[int] = []
 
-    def find(v: int) -> tuple[int, float]:
+    def find(v: int) -> int:
         path = []
         while parent[v] != v:
             path.append(v)
@@ -44,15 +44,16 @@ def alias_classes(n_vars: int, links: Iterable[tuple[int, int, float]],
             acc *= sign[node]
             sign[node] = acc
             parent[node] = root
-        return root, 1.0
+        return root
 
     for k, (a, b, s) in enumerate(links):
-        ra, _ = find(a)
-        rb, _ = find(b)
-        sa, sb = sign[a] if a != ra else 1.0, sign[b] if b != rb else 1.0
+        pa, pb = parent[a], parent[b]
+        ra = a if pa == a else (pa if parent[pa] == pa else find(a))
+        rb = b if pb == b else (pb if parent[pb] == pb else find(b))
         if ra == rb:
             redundant.append(k)
             continue
+        sa, sb = sign[a] if a != ra else 1.0, sign[b] if b != rb else 1.0
         # a = sa*ra, b = sb*rb, a = s*b  =>  ra = (s*sb/sa) * rb
         factor = s * sb / sa
         if rank[ra] > rank[rb]:
@@ -61,6 +62,7 @@ def alias_classes(n_vars: int, links: Iterable[tuple[int, int, float]],
             parent[ra], sign[ra] = rb, factor
     rep, out_sign = [0] * n_vars, [1.0] * n_vars
     for v in range(n_vars):
-        r, _ = find(v)
+        p = parent[v]
+        r = v if p == v else (p if parent[p] == p else find(v))
         rep[v], out_sign[v] = r, (sign[v] if v != r else 1.0)
     return AliasClasses(rep, out_sign, redundant)
