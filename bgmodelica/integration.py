@@ -103,7 +103,7 @@ def _run_integrator(F: ca.Function, x0, z0, p, nx: int, nz: int, n_out: int):
     except RuntimeError:
         F(x0=x0, z0=z0, p=p)           # raises with the message
         raise
-    xf = fast.res[F.index_out("xf")].reshape(n_out, nx).T.copy()
-    zf = fast.res[F.index_out("zf")].reshape(n_out, nz).T.copy() if nz \
-        else np.zeros((0, n_out))
+    # views of this call's own buffers (a fresh Fast per run): the caller's hstack copies once
+    xf = fast.res[F.index_out("xf")].reshape(n_out, nx).T
+    zf = fast.res[F.index_out("zf")].reshape(n_out, nz).T if nz else np.zeros((0, n_out))
     return xf, zf, fast.stats()

@@ -187,6 +187,10 @@ def _bounds(decl: Any) -> tuple[float | None, float | None]:
     return (None if lo is None else float(lo)), (None if hi is None else float(hi))
 
 
+def _has_bounds(decl: Any) -> bool:
+    return getattr(decl, "min", None) is not None or getattr(decl, "max", None) is not None
+
+
 def _range_text(lo: float | None, hi: float | None) -> str:
     return (f"[{'-inf' if lo is None else f'{lo:g}'}, {'inf' if hi is None else f'{hi:g}'}]")
 
@@ -210,10 +214,14 @@ def check_values(dae: Any, p: np.ndarray, flat: Any = None) -> None:
 
     p = np.asarray(p, dtype=float)
     n_par = len(dae.parameters)
+    finite = np.isfinite(p).tolist()
+    values = p.tolist()
     for k, q in enumerate(dae.parameters):
-        _check_one("parameter", q.name, float(p[k]), q.decl, _declared(q))
+        if not finite[k] or _has_bounds(q.decl):
+            _check_one("parameter", q.name, values[k], q.decl, _declared(q))
     for k, u in enumerate(dae.inputs):
-        _check_one("input", u.name, float(p[n_par + k]), u.decl, _declared(u))
+        if not finite[n_par + k] or _has_bounds(u.decl):
+            _check_one("input", u.name, values[n_par + k], u.decl, _declared(u))
     bad = [d.name for k, d in enumerate(getattr(dae, "discretes", ()))
            if not math.isfinite(float(p[n_par + len(dae.inputs) + k]))
            and not d.name.startswith("$")]
@@ -232,8 +240,11 @@ def check_values(dae: Any, p: np.ndarray, flat: Any = None) -> None:
     for k, value in dae.fixed:
         name = dae.names[k]
         v = decls.get(name)
-        _check_one("start value of", name, float(value), v.decl if v is not None else None,
-                   _declared(v) if v is not None else "")
+        decl = v.decl if v is not None else None
+        value = float(value)
+        if math.isfinite(value) and not _has_bounds(decl):
+            continue
+        _check_one("start value of", name, value, decl, _declared(v) if v is not None else "")
     for names, starts in ((dae.state_names, dae.x_start), (dae.algebraic_names, dae.z_start)):
         for name, value in zip(names, np.asarray(starts, dtype=float), strict=False):
             if not math.isfinite(value):

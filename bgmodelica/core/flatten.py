@@ -383,13 +383,16 @@ class _Flattener:
             self.columns.append(totals)
         if not pairs.a:
             return
-        ia = [self.pos[id(s)] for s in pairs.a]
-        ib = [self.pos[id(s)] for s in pairs.b]
+        pos, var_of = self.pos, self.var_of.get
+        ia = [pos[id(s)] for s in pairs.a]
+        ib = [pos[id(s)] for s in pairs.b]
         res = self.all_sx[ia] + self.all_sx[ib] * ca.DM(pairs.coef)
-        for k, r in enumerate(ca.vertsplit(res)):
-            va, vb = self.var_of.get(id(pairs.a[k])), self.var_of.get(id(pairs.b[k]))
-            alias = (va, vb, -pairs.coef[k]) if va is not None and vb is not None else None
-            self.equations.append(FlatEquation(r, pairs.origin[k], alias))
+        va = [var_of(id(s)) for s in pairs.a]
+        vb = [var_of(id(s)) for s in pairs.b]
+        self.equations.extend(
+            FlatEquation(r, origin, (a, b, -c) if a is not None and b is not None else None)
+            for r, origin, a, b, c in zip(ca.vertsplit(res), pairs.origin, va, vb, pairs.coef,
+                                          strict=True))
         self.columns.append(res)
 
     # -- component equations ---------------------------------------------------------------
