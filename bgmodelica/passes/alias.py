@@ -117,16 +117,18 @@ def _complement(n: int, removed: set[int]) -> list[int]:
 
 def _ranks(variables: list[FlatVariable], links: list[tuple[int, int, float]]) -> list[int]:
     """Integer ranks (higher: better representative of an alias class) of the linked
-    variables, by (has a derivative, state_select, fixed start, fewer dots, shorter name):
-    dense ranks of those keys in lexicographic order (0 for variables in no link)."""
-    ends = np.array([(a, b) for a, b, _ in links], dtype=np.int64)
-    linked = np.unique(ends).tolist()
-    keys = np.array([(v.der >= 0, int(getattr(v.decl, "state_select", 0)),
-                      bool(getattr(v.decl, "fixed", False)), -v.name.count("."), -len(v.name))
-                     for v in map(variables.__getitem__, linked)], dtype=np.int64)
-    out = np.zeros(len(variables), dtype=np.int64)
-    out[linked] = np.unique(keys, axis=0, return_inverse=True)[1].ravel()
-    return out.tolist()
+    variables, by (has a derivative, state_select, fixed start, fewer dots, shorter name)."""
+    linked = {i for a, b, _ in links for i in (a, b)}
+    keys = {}
+    for i in linked:
+        v = variables[i]
+        keys[i] = (v.der >= 0, getattr(v.decl, "state_select", 0),
+                   bool(getattr(v.decl, "fixed", False)), -v.name.count("."), -len(v.name))
+    dense = {key: k for k, key in enumerate(sorted(set(keys.values())))}
+    out = [0] * len(variables)
+    for i, key in keys.items():
+        out[i] = dense[key]
+    return out
 
 
 def _ensure_derivative(variables: list[FlatVariable], i: int) -> int:
