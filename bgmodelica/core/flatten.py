@@ -399,8 +399,10 @@ class _Flattener:
     def _component_equations(self) -> None:
         groups: dict[Any, list] = {}
         slow: list[tuple[ca.SX, str]] = []
+        last, where = None, ""
         for eq, ctx in self.pending:
-            where = self.where(ctx)
+            if ctx is not last:                  # a component's equations come together
+                last, where = ctx, self.where(ctx)
             if isinstance(eq, ArrayEquation):
                 self.blocks.append((eq, where))
                 continue
