@@ -55,9 +55,9 @@ def reduce_index(model: FlatModel | ReducedModel,
     if isinstance(model, ReducedModel):
         links = list(model.graph.eq_derivative)
         model = model.model
-    syms = [v.sx for v in model.variables]
     eq_vars = [list(row) for row in model_incidence(model)]
-    graph = EquationGraph(eq_vars, len(syms), [v.der for v in model.variables], links)
+    graph = EquationGraph(eq_vars, len(model.variables), [v.der for v in model.variables],
+                          links)
     try:
         pant = pantelides(graph)
     except StructurallySingular as err:
@@ -106,7 +106,8 @@ def reduce_index(model: FlatModel | ReducedModel,
         eq_derivative[of] = new
     exact = EquationGraph(rows, len(variables), [v.der for v in variables], eq_derivative)
     base = exact.base_vars()
-    priority = [int(variables[base[j]].state_select) for j in range(len(variables))]
+    declared = [int(getattr(v.decl, "state_select", 0)) for v in variables]
+    priority = [declared[b] for b in base]
     try:
         dd = dummy_derivatives(exact, priority, select=select)
     except StateSelectionError as err:

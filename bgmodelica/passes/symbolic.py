@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from itertools import chain
 
 import casadi as ca
+import numpy as np
 
 #: a sum over more terms than this is a long row (see :func:`incidence`)
 LONG_ROW = 64
@@ -147,40 +149,53 @@ def solve_scalar_blocks(residuals: Sequence[ca.SX], vars_: Sequence[ca.SX],
         return [], ca.SX(0, 1), []
     r_all = ca.vertcat(*residuals) if r_all is None else r_all
     v_all = ca.vertcat(*vars_) if v_all is None else v_all
-    neighbours: list[set[int]] = [set() for _ in range(n)]
     if rows is None:
         rows = _incidence(residuals, vars_, r_all, v_all, long)
-    for i, row in enumerate(rows):
-        for j in row:
-            if i != j:
-                neighbours[i].add(j)
-                neighbours[j].add(i)
-    color = [-1] * n
-    for k in range(n):
-        used = {color[j] for j in neighbours[k] if color[j] >= 0}
-        c = 0
-        while c in used:
-            c += 1
-        color[k] = c
+    color = _greedy_coloring(n, rows)
     out: list[ca.SX | None] = [None] * n
     position = [-1] * n
-    by_color: list[list[int]] = [[] for _ in range(max(color) + 1)]
-    for k, c in enumerate(color):
-        by_color[c].append(k)
     columns, offset = [], 0
-    for members in by_color:
+    for c in range(int(color.max()) + 1):
+        members = np.flatnonzero(color == c).tolist()
         r = r_all[members]
         v = v_all[members]
         a = ca.jtimes(r, v, ca.DM.ones(len(members)))      # diagonal: no cross terms
-        nonlinear = set(ca.jacobian_sparsity(a, v).get_triplet()[0])
         b = ca.substitute(r, v, ca.DM.zeros(len(members)))
         column = -b / a
         sol = ca.vertsplit(column) if len(members) > 1 else [column]
-        nonzero = set(ca.sparsify(a).sparsity().row())    # a = 0: not solvable for v
-        for m, k in enumerate(members):
-            if m not in nonlinear and m in nonzero:
-                out[k] = sol[m]
-                position[k] = offset + m
+        solvable = np.zeros(len(members), dtype=bool)
+        solvable[ca.sparsify(a).sparsity().row()] = True  # a = 0: not solvable for v
+        solvable[ca.jacobian_sparsity(a, v).get_triplet()[0]] = False    # nonlinear in v
+        for m in np.flatnonzero(solvable).tolist():
+            out[members[m]] = sol[m]
+            position[members[m]] = offset + m
         columns.append(column)
         offset += len(members)
     return out, ca.vertcat(*columns), position
+
+
+def _greedy_coloring(n: int, rows: Sequence[Sequence[int]]) -> np.ndarray:
+    """Colors of ``n`` pairs such that no residual depends on another variable of its own
+    color: greedy in index order (the smallest color no lower-indexed neighbour has). Pairs
+    without neighbours, most of them in large models, get color 0 without a visit."""
+    lengths = np.fromiter(map(len, rows), dtype=np.int64, count=n)
+    ii = np.repeat(np.arange(n), lengths)
+    jj = np.fromiter(chain.from_iterable(rows), dtype=np.int64, count=int(lengths.sum()))
+    cross = ii != jj
+    ii, jj = ii[cross].tolist(), jj[cross].tolist()
+    color = np.zeros(n, dtype=np.int64)
+    if not ii:
+        return color
+    neighbours: dict[int, set[int]] = {}
+    for i, j in zip(ii, jj, strict=True):
+        neighbours.setdefault(i, set()).add(j)
+        neighbours.setdefault(j, set()).add(i)
+    done: dict[int, int] = {}
+    for k in sorted(neighbours):
+        used = {done[j] for j in neighbours[k] if j in done}
+        c = 0
+        while c in used:
+            c += 1
+        done[k] = c
+    color[list(done)] = list(done.values())
+    return color

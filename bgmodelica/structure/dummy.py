@@ -66,6 +66,10 @@ def dummy_derivatives(
     n = graph.n_vars
     var_der = graph.var_derivative
     eq_vars = graph.eq_vars
+    if all(d == -1 for d in graph.eq_derivative):     # nothing differentiated: no dummies
+        derivative_chains(var_der, "variable")           # still reject malformed chains
+        states = [v for v in range(n) if var_der[v] != -1]
+        return DummyDerivativeResult([], states, [], False)
     var_int, var_order, base = derivative_chains(var_der, "variable")
     eq_int, eq_order, _ = derivative_chains(graph.eq_derivative, "equation")
     prio_list = list(priority) if priority is not None else []

@@ -6,6 +6,7 @@ import gc
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from itertools import chain
 
 import numpy as np
 
@@ -57,9 +58,8 @@ class EquationGraph:
             raise ValueError(f"var_derivative has {len(self.var_derivative)} entries, not {n}")
         if len(self.eq_derivative) != m:
             raise ValueError(f"eq_derivative has {len(self.eq_derivative)} entries, not {m}")
-        lo = min((min(vs) for vs in self.eq_vars if vs), default=0)
-        hi = max((max(vs) for vs in self.eq_vars if vs), default=-1)
-        if lo < 0 or hi >= n:
+        used = np.fromiter(chain.from_iterable(self.eq_vars), dtype=np.int64)
+        if used.size and (used.min() < 0 or used.max() >= n):
             bad = next(i for i, vs in enumerate(self.eq_vars)
                        if vs and (min(vs) < 0 or max(vs) >= n))
             raise ValueError(f"equation {bad} references a variable out of range 0..{n - 1}")

@@ -1,14 +1,17 @@
 """Long sums (a ground node joined to every section) are kept out of the whole-model
-sparsity pass: same incidence, same compiled model, and the flag survives the passes."""
+sparsity pass: same incidence, same compiled model, and the flag survives the passes. Also
+the coloring that batches the explicit scalar solutions."""
 
 from __future__ import annotations
 
 import random
 
 import casadi as ca
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import bgmodelica as bg
-from bgmodelica.passes.symbolic import LONG_ROW, incidence
+from bgmodelica.passes.symbolic import LONG_ROW, _greedy_coloring, incidence
 from library.examples import RCLadder
 
 
@@ -38,3 +41,32 @@ def test_ground_balance_is_marked_long_and_compiles_as_without_the_split(monkeyp
     assert plain.summary()["states"] == compiled.summary()["states"]
     ref = bg.simulate(plain, stop_time=0.2, interval=0.1)
     assert all((res[k] == ref[k]).all() for k in ref.names)
+
+
+def _reference_coloring(n, rows):
+    """Greedy coloring, written plainly: every pair in index order."""
+    neighbours = [set() for _ in range(n)]
+    for i, row in enumerate(rows):
+        for j in row:
+            if i != j:
+                neighbours[i].add(j)
+                neighbours[j].add(i)
+    color = [-1] * n
+    for k in range(n):
+        used = {color[j] for j in neighbours[k] if color[j] >= 0}
+        c = 0
+        while c in used:
+            c += 1
+        color[k] = c
+    return color
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(1, 25).flatmap(lambda n: st.lists(
+    st.lists(st.integers(0, n - 1), max_size=4), min_size=n, max_size=n)))
+def test_scalar_block_coloring_is_the_plain_greedy_one(rows):
+    n = len(rows)
+    color = _greedy_coloring(n, rows).tolist()
+    assert color == _reference_coloring(n, rows)
+    for i, row in enumerate(rows):          # no residual sees another variable of its color
+        assert all(color[j] != color[i] for j in row if j != i)
