@@ -317,8 +317,8 @@ _SMOOTH_OPS = frozenset(_FUNCTIONS) | LAZY_FUNCTIONS | {"atan2", "fmin", "fmax"}
 
 def _block_operand(x: Any) -> bool:
     if isinstance(x, ArrayExpr):
-        if x.node is None:
-            return all(isinstance(item, Leaf) for item in x.items.flat)
+        if x.node is None:                 # one type test per distinct element type
+            return all(issubclass(t, Leaf) for t in set(map(type, x.items.flat)))
         return all(_block_operand(a) for a in x.node[1])
     if isinstance(x, (Number, float)):
         return True

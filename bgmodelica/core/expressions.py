@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 import casadi as ca
+import numpy as np
 
 from ..errors import EquationError
 from .expr import (
@@ -43,12 +44,28 @@ def der(expr: Any) -> Any:
     if isinstance(expr, Number):
         return 0.0
     if isinstance(expr, ArrayBase):
-        return expr.map(der)
+        rates = _leaf_rates(expr)
+        return rates if rates is not None else expr.map(der)
     if isinstance(expr, Expr):
         return differentiate(expr, _rate)
     if isinstance(expr, (ca.SX, ca.MX)):
         return _der_sx(ca.SX(expr))
     raise EquationError(f"der() of {expr!r}: not an expression")
+
+
+def _leaf_rates(expr: ArrayBase) -> Any:
+    """``der`` of a stored array of declared scalars (``der(v[:-1])``), element by element
+    without the general differentiation; None for any other array."""
+    from .arrays import ArrayExpr, _wrap
+
+    if not isinstance(expr, ArrayExpr) or expr.node is not None:
+        return None
+    items = expr.items
+    if not all(issubclass(t, Leaf) for t in set(map(type, items.flat))):
+        return None
+    out = np.empty(items.size, dtype=object)
+    out[:] = [_rate(leaf.sym) for leaf in items.flat]
+    return _wrap(out.reshape(items.shape))
 
 
 def _rate(sym: Any) -> Any:

@@ -8,6 +8,7 @@ written once in a component class body. Each component instance turns every decl
 
 from __future__ import annotations
 
+import functools
 import weakref
 from dataclasses import dataclass, replace
 from enum import IntEnum
@@ -212,7 +213,7 @@ class Symbol:
         if self.decl.kind == KIND_PARAMETER:
             raise DeclarationError(f"der() of parameter {self.name!r}: parameters are constant")
         if self.der is None:
-            self.der = Symbol(f"der({self.name})", Variable(unit=derivative_unit(self.decl.unit)),
+            self.der = Symbol(f"der({self.name})", _derivative_declaration(self.decl.unit),
                               self.owner, der_of=self)
         return self.der
 
@@ -250,6 +251,12 @@ def derivative_unit(unit: str) -> str:
     if not unit or unit == "1":
         return "1/s"
     return f"{unit}/s"
+
+
+@functools.lru_cache(maxsize=256)
+def _derivative_declaration(unit: str) -> Variable:
+    """The declaration of a derivative of a quantity in ``unit`` (immutable, so shared)."""
+    return Variable(unit=derivative_unit(unit))
 
 
 #: SX node hash -> Symbol, so ``der(x)`` can find the declaration behind an SX scalar.

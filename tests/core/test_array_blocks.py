@@ -190,3 +190,18 @@ def test_block_equation_in_a_hybrid_model():
     ref = np.where(t <= 0.5, np.exp(-t), np.exp(-0.5) * np.exp(-3.0 * (t - 0.5)))
     for k, x0 in enumerate([1.0, 2.0, 4.0]):
         assert np.max(np.abs(res[f"x[{k + 1}]"] - x0 * ref)) < 1e-7
+
+
+def test_der_of_a_stored_array_is_the_elementwise_der():
+    g = Grid()
+    fast = der(g.x[:, 1:])
+    assert isinstance(fast, ArrayExpr) and fast.shape == (2, 2)
+    for i in range(2):
+        for j in range(2):
+            elem = fast.items[i, j]
+            assert elem.sym is g.x[i, j + 1].sym.der            # the one derivative symbol
+            assert elem.sym is der(g.x[i, j + 1]).sym
+    assert [float(d) for d in der(g.a).items.flat] == [0.0, 0.0]   # parameters: constant
+    mixed = der(g.x[0, :] * 2.0)                      # not stored leaves: the general rule
+    assert isinstance(mixed, ArrayExpr) and mixed.shape == (3,)
+    assert str(to_sx(mixed.items[1])) == str(to_sx(2.0 * der(g.x[0, 1])))
