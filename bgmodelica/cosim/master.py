@@ -343,7 +343,10 @@ class Master:
                     return
                 parts = []
                 for n in names:
-                    parts.append(coupled(n, y))
+                    u = coupled(n, y)
+                    if n not in signals:        # the next step starts from these inputs
+                        reuse[n] = u
+                    parts.append(u)
                     parts.append(y[n])
                     if extra[n]:
                         parts.append(units[n].get(extra[n]))
@@ -351,6 +354,7 @@ class Master:
                 times[row] = t
                 row += 1
 
+            reuse: dict[str, np.ndarray] = {}     # inputs recorded at the last point
             record_point(0, t0)
             terminated: dict[str, Any] | None = None
             u_prev: dict[str, np.ndarray] | None = None
@@ -358,7 +362,8 @@ class Master:
             for k in range(n_steps):
                 t = t0 + k * h
                 t_now[0] = t
-                u_now = {n: coupled(n, y) for n in names}
+                u_now = {n: reuse[n] if n in reuse else coupled(n, y) for n in names}
+                reuse.clear()
                 if order == "jacobi":
                     for n in names:
                         slope = None
@@ -423,6 +428,9 @@ class Master:
                                   "reason": units[first].stop_reason}
                     record_point(n_steps, units[first].time)
                     break
+                if max_abs is None and np.isfinite(np.concatenate(list(y.values()))).all():
+                    record_point(k + 1, t0 + (k + 1) * h)        # all finite: the usual case
+                    continue
                 for n in names:
                     bad_mask = ~np.isfinite(y[n])
                     if max_abs is not None:
