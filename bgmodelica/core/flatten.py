@@ -102,7 +102,7 @@ class _Flattener:
             self.pending, draft = flatten_hybrid.extract(self.pending, self.where)
             self.draft = None if draft.empty else draft
         variables, parameters, inputs, discretes, symbols = self._collect_symbols()
-        positions = self._bind(symbols)
+        self._bind(symbols)
         self._connection_equations()
         self._component_equations()
         initial = self._initial_equations()
@@ -118,7 +118,8 @@ class _Flattener:
                          discretes=discretes, hybrid=hybrid, sources=sources,
                          initial_equations=initial)
         flat.remember_stacked(ca.vertcat(*self.columns) if self.columns else None,
-                              *[take(self.all_sx, positions.get(id(kind), []))
+                              *[take(self.all_sx, [self.pos[id(sym)] for sym, target, _ in symbols
+                                                   if target is kind])
                                 for kind in (variables, declared)])
         return flat
 
@@ -244,35 +245,22 @@ class _Flattener:
                 discretes.append(FlatVariable(name, None, sym.decl, ""))
         return variables, parameters, inputs, discretes, symbols
 
-    def _bind(self, symbols) -> dict[int, list[int]]:
-        """Give every symbol an SX scalar: fresh ones become elements of one SX vector.
-        Returns id(target list) -> the positions in ``self.all_sx`` of its symbols, in order."""
+    def _bind(self, symbols) -> None:
+        """Give every symbol an SX scalar: fresh ones become elements of one SX vector."""
         fresh = [entry for entry in symbols if entry[0]._sx is None]
         old = [entry for entry in symbols if entry[0]._sx is not None]
         big = ca.SX.sym("v", len(fresh))
         pos = self.pos
-        positions: dict[int, list[int]] = {}
-        last, column = None, []
         for k, ((sym, target, index), sx) in enumerate(
                 zip(fresh, ca.vertsplit(big) if fresh else [], strict=True)):
             sym._sx = sx                        # Symbol.bind, without a call per symbol
             target[index].sx = sx
             pos[id(sym)] = k
-            if target is not last:
-                last = target
-                if id(target) not in positions:
-                    positions[id(target)] = [0] * len(target)
-                column = positions[id(target)]
-            column[index] = k
         for k, (sym, target, index) in enumerate(old, start=len(fresh)):
             target[index].sx = sym._sx
             pos[id(sym)] = k
-            if id(target) not in positions:
-                positions[id(target)] = [0] * len(target)
-            positions[id(target)][index] = k
         pos[id(TIME)] = len(fresh) + len(old)
         self.all_sx = ca.vertcat(big, *[entry[0]._sx for entry in old], TIME.sx)
-        return positions
 
     def _lower_binding(self, p: FlatVariable) -> FlatVariable:
         if isinstance(p.decl.value, Expr):
