@@ -53,6 +53,7 @@ from typing import Any
 import numpy as np
 
 from ..result import Result
+from . import flat_jacobi
 from .archive import _size
 from .checks import Plan, check_parameter_value, check_system
 from .errors import (
@@ -354,95 +355,105 @@ class Master:
                 times[row] = t
                 row += 1
 
-            reuse: dict[str, np.ndarray] = {}     # inputs recorded at the last point
-            record_point(0, t0)
-            terminated: dict[str, Any] | None = None
-            u_prev: dict[str, np.ndarray] | None = None
-            wall1 = _time.perf_counter()
-            for k in range(n_steps):
-                t = t0 + k * h
-                t_now[0] = t
-                u_now = {n: reuse[n] if n in reuse else coupled(n, y) for n in names}
-                reuse.clear()
-                if order == "jacobi":
-                    for n in names:
-                        slope = None
-                        if extrapolation and u_prev is not None and len(u_now[n]):
-                            slope = (u_now[n] - u_prev[n]) / h
-                        if n in signals:
-                            slope = np.zeros(len(u_now[n])) if slope is None else slope
-                            for j, f in signals[n]:
-                                slope[j] = (f(t + h, True) - u_now[n][j]) / h
-                        units[n].step(t, h, u_now[n], slope)
-                        last_set[n] = u_now[n] if slope is None else None
-                    y = {n: units[n].get_outputs() for n in names}
-                else:
-                    y_old = dict(y)
-                    fresh = {m: np.zeros(len(plan.outputs[m]), dtype=bool) for m in names}
-                    for n in seq:
-                        u0 = u_now[n].copy()
-                        slope = np.zeros_like(u0) if extrapolation else None
-                        for j, s in enumerate(src_index[n]):
-                            if s is None:
-                                continue
-                            if fresh[s[0]][s[1]]:       # a t_k+1 value: interpolate
-                                new, old = y[s[0]][s[1]], y_old[s[0]][s[1]]
-                                if extrapolation:
-                                    u0[j], slope[j] = old, (new - old) / h
-                                else:
-                                    u0[j] = new
-                            elif extrapolation and u_prev is not None:
-                                slope[j] = (u_now[n][j] - u_prev[n][j]) / h
-                            elif not extrapolation:
-                                u0[j] = y[s[0]][s[1]]   # the newest value there is
-                        if n in signals:
-                            slope = np.zeros_like(u0) if slope is None else slope
-                            for j, f in signals[n]:
-                                u0[j] = f(t)
-                                slope[j] = (f(t + h, True) - u0[j]) / h
-                        units[n].step(t, h, u0, slope)
-                        last_set[n] = u0 if slope is None else None
-                        y[n] = units[n].get_outputs()
-                        if propagate and has_feed[n]:
-                            u = coupled(n, y)
-                            units[n].set_inputs(u)
-                            last_set[n] = u
-                            y[n] = units[n].get_outputs()
-                        # an output is at t_k+1 if every input it depends on directly is
-                        fresh_in = {plan.inputs[n][j]: s is None or bool(fresh[s[0]][s[1]])
-                                    for j, s in enumerate(src_index[n])}
-                        fresh[n] = np.array([all(fresh_in.get(u, True)
-                                                 for u in plan.feedthrough[n].get(yn, []))
-                                             for yn in plan.outputs[n]], dtype=bool)
-                t_now[0] = t + h
+            def diverging(ys: dict[str, np.ndarray], t: float) -> None:
+                """Raise when an output at ``t + h`` is not finite (or exceeds max_abs)."""
                 for n in names:
-                    if last_set[n] is None:
-                        last_set[n] = np.full(len(u_now[n]), np.nan)
-                if propagate:
-                    propagate_outputs()
-                u_prev = u_now
-                stopped = [n for n in names if units[n].terminated]
-                if stopped:
-                    first = min(stopped, key=lambda n: units[n].time)
-                    terminated = {"element": first, "time": units[first].time,
-                                  "reason": units[first].stop_reason}
-                    record_point(n_steps, units[first].time)
-                    break
-                if max_abs is None and np.isfinite(np.concatenate(list(y.values()))).all():
-                    record_point(k + 1, t0 + (k + 1) * h)        # all finite: the usual case
-                    continue
-                for n in names:
-                    bad_mask = ~np.isfinite(y[n])
+                    bad_mask = ~np.isfinite(ys[n])
                     if max_abs is not None:
-                        bad_mask |= np.abs(y[n]) > max_abs
+                        bad_mask |= np.abs(ys[n]) > max_abs
                     if bad_mask.any():
-                        bad = [f"{plan.outputs[n][i]} = {y[n][i]:g}"
+                        bad = [f"{plan.outputs[n][i]} = {ys[n][i]:g}"
                                for i in np.flatnonzero(bad_mask)]
                         raise CosimStepError(
                             f"element {n!r}: output(s) {', '.join(bad)} at t={t + h:g}: the "
                             f"co-simulation diverges (unstable coupling at macro step {h:g} s?)",
                             n, t + h)
-                record_point(k + 1, t0 + (k + 1) * h)
+
+            reuse: dict[str, np.ndarray] = {}     # inputs recorded at the last point
+            record_point(0, t0)
+            terminated: dict[str, Any] | None = None
+            u_prev: dict[str, np.ndarray] | None = None
+            wall1 = _time.perf_counter()
+            if flat_jacobi.applies(units, order=order, extrapolation=extrapolation,
+                                   signals=signals):
+                loop = flat_jacobi.FlatJacobi(units, names, start_u, gather, feed_order, extra)
+                loop.load(y)
+                row, terminated = loop.run(t0, h, n_steps, every, propagate, last_set, data,
+                                           times, row, diverging, max_abs is not None)
+            else:
+                for k in range(n_steps):
+                    t = t0 + k * h
+                    t_now[0] = t
+                    u_now = {n: reuse[n] if n in reuse else coupled(n, y) for n in names}
+                    reuse.clear()
+                    if order == "jacobi":
+                        for n in names:
+                            slope = None
+                            if extrapolation and u_prev is not None and len(u_now[n]):
+                                slope = (u_now[n] - u_prev[n]) / h
+                            if n in signals:
+                                slope = np.zeros(len(u_now[n])) if slope is None else slope
+                                for j, f in signals[n]:
+                                    slope[j] = (f(t + h, True) - u_now[n][j]) / h
+                            units[n].step(t, h, u_now[n], slope)
+                            last_set[n] = u_now[n] if slope is None else None
+                        y = {n: units[n].get_outputs() for n in names}
+                    else:
+                        y_old = dict(y)
+                        fresh = {m: np.zeros(len(plan.outputs[m]), dtype=bool) for m in names}
+                        for n in seq:
+                            u0 = u_now[n].copy()
+                            slope = np.zeros_like(u0) if extrapolation else None
+                            for j, s in enumerate(src_index[n]):
+                                if s is None:
+                                    continue
+                                if fresh[s[0]][s[1]]:       # a t_k+1 value: interpolate
+                                    new, old = y[s[0]][s[1]], y_old[s[0]][s[1]]
+                                    if extrapolation:
+                                        u0[j], slope[j] = old, (new - old) / h
+                                    else:
+                                        u0[j] = new
+                                elif extrapolation and u_prev is not None:
+                                    slope[j] = (u_now[n][j] - u_prev[n][j]) / h
+                                elif not extrapolation:
+                                    u0[j] = y[s[0]][s[1]]   # the newest value there is
+                            if n in signals:
+                                slope = np.zeros_like(u0) if slope is None else slope
+                                for j, f in signals[n]:
+                                    u0[j] = f(t)
+                                    slope[j] = (f(t + h, True) - u0[j]) / h
+                            units[n].step(t, h, u0, slope)
+                            last_set[n] = u0 if slope is None else None
+                            y[n] = units[n].get_outputs()
+                            if propagate and has_feed[n]:
+                                u = coupled(n, y)
+                                units[n].set_inputs(u)
+                                last_set[n] = u
+                                y[n] = units[n].get_outputs()
+                            # an output is at t_k+1 if every input it depends on directly is
+                            fresh_in = {plan.inputs[n][j]: s is None or bool(fresh[s[0]][s[1]])
+                                        for j, s in enumerate(src_index[n])}
+                            fresh[n] = np.array([all(fresh_in.get(u, True)
+                                                     for u in plan.feedthrough[n].get(yn, []))
+                                                 for yn in plan.outputs[n]], dtype=bool)
+                    t_now[0] = t + h
+                    for n in names:
+                        if last_set[n] is None:
+                            last_set[n] = np.full(len(u_now[n]), np.nan)
+                    if propagate:
+                        propagate_outputs()
+                    u_prev = u_now
+                    stopped = [n for n in names if units[n].terminated]
+                    if stopped:
+                        first = min(stopped, key=lambda n: units[n].time)
+                        terminated = {"element": first, "time": units[first].time,
+                                      "reason": units[first].stop_reason}
+                        record_point(n_steps, units[first].time)
+                        break
+                    if max_abs is not None or \
+                            not np.isfinite(np.concatenate(list(y.values()))).all():
+                        diverging(y, t)
+                    record_point(k + 1, t0 + (k + 1) * h)
             wall_run = _time.perf_counter() - wall1
         finally:
             for unit in units.values():

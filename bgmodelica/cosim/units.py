@@ -345,14 +345,18 @@ class CoSimUnit(_Unit):
             if status <= 1:                          # fmi2OK, fmi2Warning
                 self.time = t + h
                 return
-            err = FMICallException(function="fmi2DoStep", status=status)
-        else:
-            try:
-                self.fmu.doStep(t, h)
-                self.time = t + h
-                return
-            except FMICallException as exc:
-                err = exc
+            self.step_failed(FMICallException(function="fmi2DoStep", status=status), t)
+            return
+        try:
+            self.fmu.doStep(t, h)
+            self.time = t + h
+        except FMICallException as exc:
+            self.step_failed(exc, t)
+
+    def step_failed(self, err: Any, t: float) -> None:
+        """After ``fmi2DoStep`` from ``t`` returned ``err.status`` > Warning: a Discard with
+        ``fmi2Terminated`` ends this unit's run (``terminated``), anything else raises
+        :class:`~.errors.CosimStepError` with the FMU's messages."""
         if err.status == 2 and self._fmi2_terminated():          # fmi2Discard
             self.terminated = True
             self.stop_reason = "the FMU asked to terminate the simulation (doStep " \
