@@ -1,9 +1,9 @@
 """The master's Jacobi loop for its most common case, as index arrays over one value vector.
 
-The case: Jacobi order without extrapolation or input signals, every unit an FMI 2.0
-Co-Simulation FMU whose coupled connectors are all Real. Then every output of every unit
-lives in one vector ``z`` (the FMUs write into it), an element's inputs are one gather
-``z[idx]`` (unconnected inputs read their start values, kept at the end of ``z``), a
+The case: Jacobi order without extrapolation or input signals, every unit a Co-Simulation
+FMU (FMI 2.0 or 3.0) whose coupled connectors are all Real (Float64). Then every output of
+every unit lives in one vector ``z`` (the FMUs write into it), an element's inputs are one
+gather ``z[idx]`` (unconnected inputs read their start values, kept at the end of ``z``), a
 recorded row is one gather too. The FMU calls, their order and their arguments are exactly
 those of the general loop in :meth:`~.master.Master.simulate`, so the results are the same to
 the last bit; only the Python work around the calls is less (about a third of it).
@@ -28,13 +28,22 @@ def applies(units: dict[str, Any], *, order: str, extrapolation: bool, signals: 
     if order != "jacobi" or extrapolation or signals:
         return False
     for unit in units.values():
-        if type(unit) is not CoSimUnit or unit.info.fmi_version != 2:
+        if type(unit) is not CoSimUnit:
             return False
         raw = unit._raw
-        if "step" not in raw or (len(unit.input_names) and "set" not in raw) \
+        if (unit.info.fmi_version == 2 and "step" not in raw) \
+                or (len(unit.input_names) and "set" not in raw) \
                 or (len(unit.output_names) and "get" not in raw):
             return False
     return True
+
+
+def _array_call(raw: Any, fmi_version: int) -> Any:
+    """``f(instance, refs, n, values)`` for FMI 2.0 ``fmi2Set/GetReal`` and FMI 3.0
+    ``fmi3Set/GetFloat64`` (which also take the number of values)."""
+    if raw is None or fmi_version == 2:
+        return raw
+    return lambda inst, refs, n, values: raw(inst, refs, n, values, n)
 
 
 class FlatJacobi:
@@ -75,8 +84,9 @@ class FlatJacobi:
             self.idx[n] = idx
             u_off += m
         base = z.ctypes.data
-        # per element: (unit, component, input gather, input refs, count, pointer to the
-        # unit's input buffer, output refs, count, pointer into z, raw set, get, doStep)
+        # per element: (name, unit, input gather, the unit's input buffer, input refs, count,
+        # pointer to the buffer, output refs, count, pointer into z, raw set, get, and the
+        # raw fmi2DoStep or None: FMI 3.0 steps through the unit)
         self.calls = []
         for n in names:
             unit = units[n]
@@ -84,8 +94,10 @@ class FlatJacobi:
             self.calls.append((
                 n, unit, self.idx[n], unit._u_buf, unit._u_vr, len(unit.input_names),
                 unit._u_ptr, unit._y_vr, len(unit.output_names),
-                ctypes.cast(base + 8 * y_off[n], _DOUBLE_P), raw.get("set"), raw.get("get"),
-                raw["step"]))
+                ctypes.cast(base + 8 * y_off[n], _DOUBLE_P),
+                _array_call(raw.get("set"), unit.info.fmi_version),
+                _array_call(raw.get("get"), unit.info.fmi_version),
+                raw.get("step") if unit.info.fmi_version == 2 else None))
         self.by_name = {c[0]: c for c in self.calls}
         # a recorded row: per element its inputs, its outputs, then its extra variables
         row_idx, self.extra_cols = [], []
@@ -171,7 +183,12 @@ class FlatJacobi:
                         unit.set_inputs(buf.copy())
                 last[n] = buf.copy()
                 unit.time = t
-                status = call[12](unit.fmu.component, t, h, 1)
+                step = call[12]
+                if step is None:                   # FMI 3.0: early returns, terminate
+                    unit._step3(t, h)
+                    failed = failed or unit.terminated
+                    continue
+                status = step(unit.fmu.component, t, h, 1)
                 if status <= 1:
                     unit.time = t + h
                 else:

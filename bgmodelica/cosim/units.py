@@ -171,7 +171,12 @@ class _Unit:
         if self.info.fmi_version == 2:
             names = {"set": "fmi2SetReal", "get": "fmi2GetReal", "step": "fmi2DoStep"}
         else:
-            names = {"set": "fmi3SetFloat64", "get": "fmi3GetFloat64"}
+            names = {"set": "fmi3SetFloat64", "get": "fmi3GetFloat64", "step": "fmi3DoStep"}
+            # fmi3DoStep's results: eventHandlingNeeded, terminateSimulation, earlyReturn,
+            # lastSuccessfulTime
+            self._step3_out = (ctypes.c_bool(), ctypes.c_bool(), ctypes.c_bool(),
+                               ctypes.c_double())
+            self._step3_refs = tuple(ctypes.pointer(v) for v in self._step3_out)
         self._raw = {k: functions[v] for k, v in names.items() if v in functions}
         if not (self._in.all_real and len(self._u_buf)):
             self._raw.pop("set", None)
@@ -317,13 +322,29 @@ class CoSimUnit(_Unit):
         u = u0 if slope is None else u0 + 0.5 * h * slope
         self.set_inputs(u)
         self.time = t
-        t_end = t + h
         if self.info.fmi_version == 2:
             self._step2(t, h)
-            return
+        else:
+            self._step3(t, h)
+
+    def _step3(self, t: float, h: float) -> None:
+        """``fmi3DoStep`` from ``t`` (``self.time``) to ``t + h``, resuming after early
+        returns; a terminate request ends the unit's run (``terminated``)."""
+        t_end = t + h
+        raw = self._raw.get("step")
         for _ in range(100000):
-            _event, term, early, last = self._call(self.fmu.doStep, self.time,
-                                                   t_end - self.time)
+            if raw is not None:                      # the C function, no wrapper
+                status = raw(self.fmu.component, self.time, t_end - self.time, True,
+                             *self._step3_refs)
+                if status > 1:                       # Discard, Error, Fatal
+                    from fmpy.fmi1 import FMICallException
+
+                    self._call(self._raise, FMICallException(function="fmi3DoStep",
+                                                             status=status))
+                term, early, last = (v.value for v in self._step3_out[1:])
+            else:
+                _event, term, early, last = self._call(self.fmu.doStep, self.time,
+                                                       t_end - self.time)
             if term:
                 self.time = float(last) if early else t_end
                 self.terminated = True

@@ -112,3 +112,38 @@ def test_same_termination(monkeypatch, robot_ssp):
     assert fast.time[-1] == pytest.approx(0.05)
     assert np.array_equal(fast.time, general.time)
     assert np.array_equal(fast.values, general.values)
+
+
+@pytest.fixture(scope="module")
+def fmi3_system(tmp_path_factory):
+    from library.robots.subsystems import build_robot_fmus, robot_system
+
+    return robot_system(build_robot_fmus(tmp_path_factory.mktemp("fmi3"), fmi_version=3,
+                                         fmu_type="cs"))
+
+
+def test_fmi3_units(monkeypatch, fmi3_system):
+    """FMI 3.0 Co-Simulation units: the same results both ways, and a terminate request
+    (fmi3DoStep's terminateSimulation) ends both at the same point."""
+    master = Master(fmi3_system)
+    fast, general = _both(monkeypatch, lambda: master.simulate(0.1, 1e-3, record_every=3))
+    assert np.array_equal(fast.values, general.values)
+    assert np.array_equal(fast.time, general.time)
+
+    from bgmodelica.cosim.units import CoSimUnit
+
+    real_step3 = CoSimUnit._step3
+
+    def step3(self, t, h):
+        if self.name == "motor2" and t >= 0.03 - 1e-12:
+            self.terminated, self.stop_reason = True, "asked to terminate (test)"
+            return
+        real_step3(self, t, h)
+
+    monkeypatch.undo()
+    monkeypatch.setattr(CoSimUnit, "_step3", step3)
+    fast, general = _both(monkeypatch, lambda: master.simulate(0.1, 1e-3))
+    assert fast.meta["terminated"] == general.meta["terminated"]
+    assert fast.meta["terminated"]["element"] == "motor2"
+    assert np.array_equal(fast.values, general.values)
+    assert fast.time[-1] == pytest.approx(0.03) and np.array_equal(fast.time, general.time)
