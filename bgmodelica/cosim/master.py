@@ -28,6 +28,12 @@ inputs held during the step), as simple masters (and ``fmucontainer``) do.
 Units: Co-Simulation FMUs (``interface="cs"``, their own solver via ``doStep``) or Model
 Exchange FMUs integrated here (``"me"``: SciPy Radau per macro step); per element with a dict.
 
+Speed: the common case (Jacobi order without extrapolation or input signals, Co-Simulation
+units whose coupled connectors are all Real) runs as a flat loop over one value vector
+(:mod:`.flat_jacobi`) that calls the FMUs' C functions directly; its results are those of the
+general loop to the last bit. In Gauss-Seidel order, which inputs read values already at
+``t_{k+1}`` is found once per run.
+
 Results: :class:`bgmodelica.Result` with ``<element>.<variable>`` names: every connector
 (inputs: the coupled value at the communication point) and any variable asked for in
 ``record``; bound parameters are in ``result.parameters``; ``result.meta`` has the options
