@@ -284,9 +284,10 @@ class _Checker:
                             lambda e=eq: self.equation(e), n)
 
     def _arrays(self, arrays: list[tuple[Any, str]]) -> None:
+        one_unit: dict[int, tuple[Any, bool]] = {}
         for eq, where in arrays:
             try:
-                first = Equation(_first(eq.lhs), _first(eq.rhs))
+                first = Equation(_first(eq.lhs, one_unit), _first(eq.rhs, one_unit))
             except _Varies:
                 self._groups(_scalar_groups(eq.equations(), where))
                 continue
@@ -443,22 +444,37 @@ class _Varies(Exception):
     """An array of an array equation holds leaves of different units."""
 
 
-def _first(x: Any) -> Any:
+def _first(x: Any, one_unit: dict[int, tuple[Any, bool]]) -> Any:
     """The first element of an array expression whose arrays each hold one unit (raises
-    :class:`_Varies` otherwise), for checking all elements at once."""
+    :class:`_Varies` otherwise), for checking all elements at once. ``one_unit`` remembers
+    per declared array (the numpy base of the slices) whether all its elements share one
+    unit: then every slice of it does."""
     if isinstance(x, ArrayExpr):
         if x.node is None:
-            items = x.items.ravel()
-            if len({_leaf_key(leaf.sym) for leaf in items}) > 1:
+            items = x.items
+            base = items.base if isinstance(items.base, np.ndarray) else items
+            known = one_unit.get(id(base))
+            if known is None:
+                known = one_unit[id(base)] = (base, _single_unit(base.ravel()))
+            if not known[1] and len({_leaf_key(leaf.sym) for leaf in items.ravel()}) > 1:
                 raise _Varies
-            return items[0]
+            return items.flat[0]
         op, args = x.node
         if op == "**" and isinstance(args[1], np.ndarray) and np.unique(args[1]).size > 1:
             raise _Varies
-        return Op(op, tuple(_first(a) for a in args))
+        return Op(op, tuple(_first(a, one_unit) for a in args))
     if isinstance(x, np.ndarray):
         return float(x.ravel()[0])
     return x
+
+
+def _single_unit(leaves: np.ndarray) -> bool:
+    """Whether the leaves (declared scalars) all have one unit key (:func:`_leaf_key`);
+    False for an array that holds anything else."""
+    try:
+        return len({_leaf_key(leaf.sym) for leaf in leaves}) <= 1
+    except AttributeError:
+        return False
 
 
 def _scalar_groups(equations: list[Equation], where: str) -> dict[Any, list]:
