@@ -28,11 +28,11 @@ inputs held during the step), as simple masters (and ``fmucontainer``) do.
 Units: Co-Simulation FMUs (``interface="cs"``, their own solver via ``doStep``) or Model
 Exchange FMUs integrated here (``"me"``: SciPy Radau per macro step); per element with a dict.
 
-Speed: the common case (Jacobi order without extrapolation or input signals, Co-Simulation
-units whose coupled connectors are all Real) runs as a flat loop over one value vector
-(:mod:`.flat_jacobi`) that calls the FMUs' C functions directly; its results are those of the
-general loop to the last bit. In Gauss-Seidel order, which inputs read values already at
-``t_{k+1}`` is found once per run.
+Speed: the common cases (either order without extrapolation or input signals, Co-Simulation
+units whose coupled connectors are all Real) run as a flat loop over one value vector
+(:mod:`.flat_loop`) that calls the FMUs' C functions directly; its results are those of the
+general loop to the last bit. With extrapolation in Gauss-Seidel order, which inputs read
+values already at ``t_{k+1}`` is found once per run.
 
 Results: :class:`bgmodelica.Result` with ``<element>.<variable>`` names: every connector
 (inputs: the coupled value at the communication point) and any variable asked for in
@@ -59,7 +59,7 @@ from typing import Any
 import numpy as np
 
 from ..result import Result
-from . import flat_jacobi
+from . import flat_loop
 from .archive import _size
 from .checks import Plan, check_parameter_value, check_system
 from .errors import (
@@ -381,12 +381,14 @@ class Master:
             terminated: dict[str, Any] | None = None
             u_prev: dict[str, np.ndarray] | None = None
             wall1 = _time.perf_counter()
-            if flat_jacobi.applies(units, order=order, extrapolation=extrapolation,
-                                   signals=signals):
-                loop = flat_jacobi.FlatJacobi(units, names, start_u, gather, feed_order, extra)
+            if flat_loop.applies(units, order=order, extrapolation=extrapolation,
+                                 signals=signals):
+                loop = flat_loop.FlatLoop(units, names, start_u, gather, feed_order, extra)
                 loop.load(y)
-                row, terminated = loop.run(t0, h, n_steps, every, propagate, last_set, data,
-                                           times, row, diverging, max_abs is not None)
+                row, terminated = loop.run(
+                    t0, h, n_steps, every, propagate, last_set, data, times, row, diverging,
+                    max_abs is not None, sequence=seq if order == "gauss-seidel" else None,
+                    feedthrough={n for n in names if has_feed[n]})
             else:
                 for k in range(n_steps):
                     t = t0 + k * h

@@ -1,5 +1,6 @@
-"""The master's flat Jacobi loop (:mod:`bgmodelica.cosim.flat_jacobi`) gives the general
-loop's results to the last bit, and stands aside where it does not apply."""
+"""The master's flat loop (:mod:`bgmodelica.cosim.flat_loop`), in Jacobi and Gauss-Seidel
+order, gives the general loop's results to the last bit, and stands aside where it does not
+apply."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import numpy as np
 import pytest
 from cosim_helpers import HORIZON, tight
 
-from bgmodelica.cosim import flat_jacobi
+from bgmodelica.cosim import flat_loop
 from bgmodelica.cosim.errors import CosimStepError
 from bgmodelica.cosim.master import Master
 
@@ -15,16 +16,16 @@ from bgmodelica.cosim.master import Master
 def _both(monkeypatch, run):
     """``run()`` through the flat loop, then through the general loop."""
     taken = []
-    real_run = flat_jacobi.FlatJacobi.run
+    real_run = flat_loop.FlatLoop.run
 
     def spy(self, *args, **kw):
         taken.append(True)
         return real_run(self, *args, **kw)
 
-    monkeypatch.setattr(flat_jacobi.FlatJacobi, "run", spy)
+    monkeypatch.setattr(flat_loop.FlatLoop, "run", spy)
     fast = run()
     assert taken, "the flat loop was not used"
-    monkeypatch.setattr(flat_jacobi, "applies", lambda *a, **k: False)
+    monkeypatch.setattr(flat_loop, "applies", lambda *a, **k: False)
     general = run()
     return fast, general
 
@@ -40,6 +41,9 @@ def _first_local(master, element: str) -> str:
     {"record_every": 7},
     {"record": "locals"},
     {"max_abs": 1e6, "record_every": 3},
+    {"order": "gauss-seidel"},
+    {"order": "gauss-seidel", "propagate": False, "record_every": 4},
+    {"order": "gauss-seidel", "sequence": ["controller", "arm", "motor2", "motor1"]},
 ])
 def test_bit_identical_to_the_general_loop(monkeypatch, robot_ssp, options):
     master = Master(robot_ssp)
@@ -50,8 +54,8 @@ def test_bit_identical_to_the_general_loop(monkeypatch, robot_ssp, options):
     assert fast.names == general.names
     assert np.array_equal(fast.time, general.time)
     assert np.array_equal(fast.values, general.values)
-    assert fast.values.shape[0] == (201 if "record_every" not in options
-                                    else 1 + -(-200 // options["record_every"]))
+    every = options.get("record_every", 1)
+    assert fast.values.shape[0] == 1 + -(-200 // every)
     assert fast.meta["terminated"] is None
 
 
@@ -72,24 +76,26 @@ def test_same_divergence_error(monkeypatch, robot_setup):
 def test_not_used_where_it_does_not_apply(robot_ssp):
     master = Master(robot_ssp)
     calls = []
-    real = flat_jacobi.applies
+    real = flat_loop.applies
 
     def spy(units, **kw):
         calls.append(real(units, **kw))
         return calls[-1]
 
-    flat_jacobi.applies = spy
+    flat_loop.applies = spy
     try:
-        master.simulate(0.01, 1e-3, order="gauss-seidel")
+        master.simulate(0.01, 1e-3, order="gauss-seidel", extrapolation=True)
         master.simulate(0.01, 1e-3, extrapolation=True)
         Master(robot_ssp, interface="me").simulate(0.01, 1e-3)
         master.simulate(0.01, 1e-3)
+        master.simulate(0.01, 1e-3, order="gauss-seidel")
     finally:
-        flat_jacobi.applies = real
-    assert calls == [False, False, False, True]
+        flat_loop.applies = real
+    assert calls == [False, False, False, True, True]
 
 
-def test_same_termination(monkeypatch, robot_ssp):
+@pytest.mark.parametrize("order", ["jacobi", "gauss-seidel"])
+def test_same_termination(monkeypatch, robot_ssp, order):
     """An FMU that asks to terminate (doStep: Discard, fmi2Terminated) at t = 0.05 ends both
     loops at the same point with the same record."""
     from bgmodelica.cosim.units import CoSimUnit
@@ -106,7 +112,7 @@ def test_same_termination(monkeypatch, robot_ssp):
     monkeypatch.setattr(CoSimUnit, "_bind_raw", bind)
     monkeypatch.setattr(CoSimUnit, "_fmi2_terminated", lambda self: True)
     master = Master(robot_ssp)
-    fast, general = _both(monkeypatch, lambda: master.simulate(0.2, 1e-3))
+    fast, general = _both(monkeypatch, lambda: master.simulate(0.2, 1e-3, order=order))
     assert fast.meta["terminated"] == general.meta["terminated"]
     assert fast.meta["terminated"]["element"] == "arm"
     assert fast.time[-1] == pytest.approx(0.05)
@@ -127,6 +133,9 @@ def test_fmi3_units(monkeypatch, fmi3_system):
     (fmi3DoStep's terminateSimulation) ends both at the same point."""
     master = Master(fmi3_system)
     fast, general = _both(monkeypatch, lambda: master.simulate(0.1, 1e-3, record_every=3))
+    assert np.array_equal(fast.values, general.values)
+    monkeypatch.undo()
+    fast, general = _both(monkeypatch, lambda: master.simulate(0.1, 1e-3, order="gauss-seidel"))
     assert np.array_equal(fast.values, general.values)
     assert np.array_equal(fast.time, general.time)
 

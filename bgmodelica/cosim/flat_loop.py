@@ -1,9 +1,10 @@
-"""The master's Jacobi loop for its most common case, as index arrays over one value vector.
+"""The master's loop for its most common cases, as index arrays over one value vector.
 
-The case: Jacobi order without extrapolation or input signals, every unit a Co-Simulation
-FMU (FMI 2.0 or 3.0) whose coupled connectors are all Real (Float64). Then every output of
-every unit lives in one vector ``z`` (the FMUs write into it), an element's inputs are one
-gather ``z[idx]`` (unconnected inputs read their start values, kept at the end of ``z``), a
+The cases: Jacobi or Gauss-Seidel order without extrapolation or input signals, every unit a
+Co-Simulation FMU (FMI 2.0 or 3.0) whose coupled connectors are all Real (Float64). Then every
+output of every unit lives in one vector ``z`` (the FMUs write into it), an element's inputs
+are one gather ``z[idx]`` (unconnected inputs read their start values, kept at the end of
+``z``; in Gauss-Seidel order ``z`` already holds the outputs of the units stepped before), a
 recorded row is one gather too. The FMU calls, their order and their arguments are exactly
 those of the general loop in :meth:`~.master.Master.simulate`, so the results are the same to
 the last bit; only the Python work around the calls is less (about a third of it).
@@ -24,8 +25,8 @@ _DOUBLE_P = ctypes.POINTER(ctypes.c_double)
 
 
 def applies(units: dict[str, Any], *, order: str, extrapolation: bool, signals: dict) -> bool:
-    """Whether :class:`FlatJacobi` can run this co-simulation."""
-    if order != "jacobi" or extrapolation or signals:
+    """Whether :class:`FlatLoop` can run this co-simulation."""
+    if order not in ("jacobi", "gauss-seidel") or extrapolation or signals:
         return False
     for unit in units.values():
         if type(unit) is not CoSimUnit:
@@ -46,7 +47,7 @@ def _array_call(raw: Any, fmi_version: int) -> Any:
     return lambda inst, refs, n, values: raw(inst, refs, n, values, n)
 
 
-class FlatJacobi:
+class FlatLoop:
     """The loop state: ``z`` = [outputs of every element (in ``names`` order), start values
     of every element's inputs]; per element the gather indices of its inputs in ``z``.
 
@@ -137,10 +138,9 @@ class FlatJacobi:
             unit.set_inputs(u)                       # raises with the FMU's messages
 
     def _get(self, call: tuple) -> None:
-        n, unit, *_ = call
         m = call[8]
-        if m and call[11](unit.fmu.component, call[7], m, call[9]) > 1:
-            self.y[n][:] = unit.get_outputs()        # raises with the FMU's messages
+        if m and call[11](call[1].fmu.component, call[7], m, call[9]) > 1:
+            self.y[call[0]][:] = call[1].get_outputs()   # raises with the FMU's messages
 
     def propagate(self, last: dict[str, np.ndarray]) -> None:
         """Re-evaluate the feedthrough outputs with the inputs of this instant (as
@@ -162,44 +162,61 @@ class FlatJacobi:
         for n, a, b in self.extra_cols:
             data[row, a:b] = self.units[n].get(self.extra[n])
 
+    def _step(self, call: tuple, t: float, h: float, last: dict[str, np.ndarray]) -> bool:
+        """Set the element's inputs from ``z`` and step it from ``t`` to ``t + h``; True when
+        the step did not succeed (the unit then says whether it terminated)."""
+        n, unit, idx, buf, vr, m, ptr = call[:7]
+        if m:
+            self.z.take(idx, out=buf)
+            if call[10](unit.fmu.component, vr, m, ptr) > 1:
+                unit.set_inputs(buf.copy())          # raises with the FMU's messages
+        last[n] = buf.copy()
+        unit.time = t
+        step = call[12]
+        if step is None:                             # FMI 3.0: early returns, terminate
+            unit._step3(t, h)
+            return unit.terminated
+        status = step(unit.fmu.component, t, h, 1)
+        if status <= 1:
+            unit.time = t + h
+            return False
+        from fmpy.fmi1 import FMICallException
+
+        unit.step_failed(FMICallException(function="fmi2DoStep", status=status), t)
+        return True
+
     def run(self, t0: float, h: float, n_steps: int, every: int, propagate: bool,
             last: dict[str, np.ndarray], data: np.ndarray, times: np.ndarray, row: int,
-            check: Callable[[dict[str, np.ndarray], float], None],
-            always_check: bool) -> tuple[int, Any]:
+            check: Callable[[dict[str, np.ndarray], float], None], always_check: bool, *,
+            sequence: list[str] | None = None, feedthrough: set[str] = frozenset()
+            ) -> tuple[int, Any]:
         """Macro steps 0..n_steps-1 from the state after the first recorded point; fills
         ``data`` and ``times`` from ``row`` on. ``check(y, t)`` raises for diverging outputs
         (called when an output is not finite, at every step when ``always_check``).
+        ``sequence``: Gauss-Seidel order (None: Jacobi); ``feedthrough``: the elements
+        whose outputs are re-evaluated right after their step in Gauss-Seidel order.
         Returns the next row and the ``terminated`` record (None when all ran to the end)."""
         z, calls = self.z, self.calls
         z_y = z[:self.n_y]
+        step_one, get_one = self._step, self._get
+        ordered = [self.by_name[n] for n in sequence] if sequence is not None else None
         for k in range(n_steps):
             t = t0 + k * h
             failed = False
-            for call in calls:
-                n, unit, idx, buf, vr, m, ptr = call[:7]
-                if m:
-                    z.take(idx, out=buf)
-                    if call[10](unit.fmu.component, vr, m, ptr) > 1:
-                        unit.set_inputs(buf.copy())
-                last[n] = buf.copy()
-                unit.time = t
-                step = call[12]
-                if step is None:                   # FMI 3.0: early returns, terminate
-                    unit._step3(t, h)
-                    failed = failed or unit.terminated
-                    continue
-                status = step(unit.fmu.component, t, h, 1)
-                if status <= 1:
-                    unit.time = t + h
-                else:
-                    from fmpy.fmi1 import FMICallException
-
-                    unit.step_failed(FMICallException(function="fmi2DoStep", status=status), t)
-                    failed = True
-            for call in calls:
-                m = call[8]
-                if m and call[11](call[1].fmu.component, call[7], m, call[9]) > 1:
-                    self.y[call[0]][:] = call[1].get_outputs()
+            if ordered is None:                      # Jacobi: all step, then all are read
+                for call in calls:
+                    failed = step_one(call, t, h, last) or failed
+                for call in calls:
+                    get_one(call)
+            else:                                    # Gauss-Seidel: each reads the newest
+                for call in ordered:
+                    failed = step_one(call, t, h, last) or failed
+                    get_one(call)
+                    if propagate and call[0] in feedthrough:
+                        u = z.take(call[2])
+                        self._set(call, u)
+                        last[call[0]] = u
+                        get_one(call)
             if propagate:
                 self.propagate(last)
             if failed:
