@@ -191,6 +191,10 @@ class _KeyWriter:
         raise Uncacheable(f"connect() of {x!r}")
 
 
+def _first_item(pair: tuple[str, Any]) -> str:
+    return pair[0]
+
+
 def model_key(model: Component) -> str:
     """The cache key of ``model``: a hex digest of its structure and code (see the module
     docstring); raises :class:`Uncacheable` for models the key cannot describe."""
@@ -204,32 +208,37 @@ def model_key(model: Component) -> str:
         elem, path = stack.pop()
         paths[id(elem)] = path
         order.append((elem, path))
+        prefix = f"{path}." if path else ""
         for name, sym in elem._symbols.items():
-            names[id(sym)] = f"{path}.{name}" if path else name
+            full = names[id(sym)] = prefix + name
             der = sym.der
             while der is not None:
-                names[id(der)] = f"der({names[id(sym)]})"
+                full = names[id(der)] = f"der({full})"
                 der = der.der
-        for child_name, child in reversed(list(elem._children.items())):
-            stack.append((child, f"{path}.{child_name}" if path else child_name))
+        children = elem._children
+        if children:
+            stack.extend((child, prefix + child_name)
+                         for child_name, child in reversed(children.items()))
     writer = _KeyWriter(paths, names)
     lines: list[str] = []
+    add = lines.append
     classes: set[type] = set()
     decl_memo: dict[int, str] = {}
+    skip = (Element, Expr, ArrayExpr, ElementArray)
     for elem, path in order:                   # pass 2: what each element holds
         cls = type(elem)
         classes.add(cls)
-        lines.append(f"E {path} {cls.__module__}.{cls.__qualname__}")
+        add(f"E {path} {cls.__module__}.{cls.__qualname__}")
         for name, sym in elem._symbols.items():
             text = decl_memo.get(id(sym.decl))
             if text is None:
                 text = decl_memo[id(sym.decl)] = writer.decl(sym.decl, path or "top")
-            lines.append(f"D {name} {text}")
-        for key, value in sorted(vars(elem).items()):
-            if key.startswith("_") or key in elem._children \
-                    or isinstance(value, (Element, Expr, ArrayExpr, ElementArray)):
-                continue
-            lines.append(f"A {key}={_value_key(value, f'{path or cls.__name__}.{key}')}")
+            add(f"D {name} {text}")
+        children = elem._children
+        plain = [(key, value) for key, value in vars(elem).items()
+                 if key[0] != "_" and key not in children and not isinstance(value, skip)]
+        for key, value in sorted(plain, key=_first_item):
+            add(f"A {key}={_value_key(value, f'{path or cls.__name__}.{key}')}")
         for item in getattr(elem, "_equations", ()):
             lines.append("Q " + writer.item(item))
         for item in elem.__dict__.get("_initial_equations", ()):
