@@ -47,9 +47,8 @@ from .variables import (
     KIND_OUTPUT,
     KIND_POTENTIAL,
     Declaration,
-    Parameter,
     Symbol,
-    Variable,
+    element_declarations,
     lookup,
 )
 
@@ -153,29 +152,10 @@ class Element:
         symbols = self._symbols
         numeric = isinstance(modifier, (int, float)) or (
             isinstance(modifier, np.ndarray) and modifier.dtype.kind in "biuf")
-        fields = _element_fields(scalar, per_field, mods, numeric)
-        if fields is None:                   # a modifier that with_start must interpret
-            for k, name in enumerate(names):
-                elem = scalar.evolve(**{f: v[k] for f, v in per_field.items()}) \
-                    if per_field else scalar
-                if mods is not None:
-                    elem = elem.with_start(mods[k])
-                sym = symbols[name] = Symbol(name, elem, self)
-                leaves.append(sym.leaf)
-        else:                                # one declaration copy per element, in place
-            varying, const = fields
-            cls, base, new = type(scalar), scalar.__dict__, object.__new__
-            for k, name in enumerate(names):
-                elem = scalar
-                if varying or const:
-                    elem = new(cls)
-                    d = elem.__dict__
-                    d.update(base)
-                    for f, values in varying:
-                        d[f] = values[k]
-                    d.update(const)
-                sym = symbols[name] = Symbol(name, elem, self)
-                leaves.append(sym.leaf)
+        for name, elem in zip(names, element_declarations(scalar, len(names), per_field, mods,
+                                                          numeric), strict=True):
+            sym = symbols[name] = Symbol(name, elem, self)
+            leaves.append(sym.leaf)
         items = np.empty(len(leaves), dtype=object)
         items[:] = leaves
         self.__dict__.setdefault("_arrays", {})[key] = shape
@@ -517,22 +497,3 @@ def _scalar_items(item: Any, blocks: bool = False) -> Iterator[Any]:
     else:
         yield item
 
-
-def _element_fields(scalar: Declaration, per_field: dict[str, list], mods: list | None,
-                    numeric: bool) -> tuple[list[tuple[str, list]], dict[str, Any]] | None:
-    """The fields the elements of an array declaration get: ``(per-element (field, values),
-    fields common to all)``, what ``evolve(**per_field[k]).with_start(mods[k])`` gives for
-    plain start/value modifiers (``numeric``: the modifier is a number or a numeric array);
-    None when a modifier needs ``with_start`` itself (a dict of fields, or a declaration
-    type with its own rule)."""
-    varying = list(per_field.items())
-    if mods is None:
-        return varying, {}
-    rule = type(scalar).with_start
-    if not numeric and any(isinstance(m, dict) for m in mods):
-        return None
-    if rule is Parameter.with_start:
-        return varying + [("value", mods)], {}
-    if rule is Variable.with_start:
-        return varying + [("start", mods)], {"fixed": True}
-    return None

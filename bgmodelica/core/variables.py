@@ -176,6 +176,40 @@ class Boolean(Discrete):
     type_name = "Boolean"
 
 
+def element_declarations(scalar: Declaration, n: int, per_field: dict[str, list],
+                         mods: list | None, numeric: bool) -> list[Declaration]:
+    """The ``n`` element declarations of an array: ``scalar`` with element ``k`` of each
+    ``per_field`` list, then ``with_start(mods[k])`` (``numeric``: the modifier is a number
+    or a numeric array). Plain start/value modifiers copy ``scalar`` once per element, in
+    place; dicts of fields and declaration types with their own rule go through
+    ``with_start``."""
+    varying = list(per_field.items())
+    const: dict[str, Any] = {}
+    rule = type(scalar).with_start
+    if mods is not None:
+        if (not numeric and any(isinstance(m, dict) for m in mods)) \
+                or rule not in (Parameter.with_start, Variable.with_start):
+            return [scalar.evolve(**{f: v[k] for f, v in varying}).with_start(mods[k])
+                    for k in range(n)]
+        if rule is Parameter.with_start:
+            varying.append(("value", mods))
+        else:
+            varying.append(("start", mods))
+            const["fixed"] = True
+    if not varying:
+        return [scalar] * n
+    cls, base, new = type(scalar), scalar.__dict__, object.__new__
+    out = []
+    for k in range(n):
+        elem = new(cls)
+        d = elem.__dict__
+        d.update(base)
+        for f, values in varying:
+            d[f] = values[k]
+        d.update(const)
+        out.append(elem)
+    return out
+
 class Symbol:
     """One declared scalar of one component instance.
 

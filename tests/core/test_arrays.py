@@ -234,3 +234,27 @@ def test_per_element_declarations_equal_dataclass_replace():
     m = RCLadderVector(3)
     assert [m._symbols[f"R[{k}]"].decl.value for k in (1, 2, 3)] == [1.0, 0.5, 1.0 / 3]
     assert [m._symbols[f"v[{k}]"].decl.start for k in (1, 2, 3)] == [1.0, 2.0, 3.0]
+
+
+def test_element_declarations_follow_with_start():
+    """Array elements get what ``with_start`` gives each scalar: start and fixed for a
+    variable, value for a parameter, the named fields for a dict; other fields unchanged."""
+    from dataclasses import replace
+
+    from bgmodelica import Component, Parameter, Variable
+
+    class Holder(Component):
+        x = Variable(shape=3, unit="m", nominal=[1.0, 2.0, 3.0])
+        p = Parameter(shape=3, value=0.5, min=0.0)
+
+    plain = Holder()
+    assert all(plain._symbols[f"x[{k}]"].decl == replace(
+        Holder.x, shape=(), nominal=float(k)) for k in (1, 2, 3))
+    assert plain._symbols["p[1]"].decl is plain._symbols["p[3]"].decl   # one shared copy
+    given = Holder(x=np.array([4.0, 5.0, 6.0]), p=[1.0, 2.0, 3.0])
+    for k in (1, 2, 3):
+        assert given._symbols[f"x[{k}]"].decl == replace(
+            Holder.x, shape=(), nominal=float(k), start=3.0 + k, fixed=True)
+        assert given._symbols[f"p[{k}]"].decl == replace(Holder.p, shape=(), value=float(k))
+    as_dict = Holder(x={"start": 7.0, "fixed": False})
+    assert as_dict._symbols["x[2]"].decl == replace(Holder.x, shape=(), nominal=2.0, start=7.0)
