@@ -25,6 +25,8 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from ..fmi.units import parse_unit
 from .errors import (
     AlgebraicLoopError,
@@ -58,6 +60,40 @@ class Plan:
     sources: dict[tuple[str, str], tuple[str, str]]
     order: list[tuple[str, str, bool]]
     feedthrough: dict[str, dict[str, list[str]]]
+
+    def gauss_seidel_sources(self, seq: list[str], src_index: dict[str, list]
+                             ) -> tuple[dict[str, list], dict[str, np.ndarray]]:
+        """Which inputs of each element read a value already at ``t_{k+1}`` when it steps in
+        Gauss-Seidel order ``seq``: the output of an element stepped before it that does not
+        depend directly on an input still at ``t_k``. The same at every macro step, so the
+        master finds it once. ``src_index[el][j]``: (source element, output position) of
+        input ``j`` or None. Returns element -> [(source, its output positions, our input
+        positions)] for those inputs, and element -> positions of the other connected
+        inputs."""
+        fresh = {m: np.zeros(len(self.outputs[m]), dtype=bool) for m in seq}
+        groups: dict[str, list] = {}
+        stale: dict[str, np.ndarray] = {}
+        for n in seq:
+            by_src: dict[str, tuple[list[int], list[int]]] = {}
+            rest = []
+            for j, s in enumerate(src_index[n]):
+                if s is None:
+                    continue
+                if fresh[s[0]][s[1]]:
+                    pair = by_src.setdefault(s[0], ([], []))
+                    pair[0].append(s[1])
+                    pair[1].append(j)
+                else:
+                    rest.append(j)
+            groups[n] = [(src, np.array(a), np.array(b)) for src, (a, b) in by_src.items()]
+            stale[n] = np.array(rest, dtype=int)
+            # an output is at t_k+1 if every input it depends on directly is
+            fresh_in = {self.inputs[n][j]: s is None or bool(fresh[s[0]][s[1]])
+                        for j, s in enumerate(src_index[n])}
+            fresh[n] = np.array([all(fresh_in.get(u, True)
+                                     for u in self.feedthrough[n].get(yn, []))
+                                 for yn in self.outputs[n]], dtype=bool)
+        return groups, stale
     unconnected: list[str]
 
 

@@ -307,7 +307,7 @@ class Master:
                         pair[0].append(s[1])
                         pair[1].append(j)
                 gather[n] = [(src, np.array(a), np.array(b)) for src, (a, b) in by_src.items()]
-            gs_fresh, gs_stale = _gauss_seidel_sources(seq, src_index, plan)
+            gs_fresh, gs_stale = plan.gauss_seidel_sources(seq, src_index)
             # elements whose outputs feed through, in evaluation order (repeats kept apart)
             feed_order: list[str] = []
             for el, _, is_out in plan.order:
@@ -485,38 +485,6 @@ class Master:
         }
         return Result(times[:row], data[:row], cols, parameters=parameters_out, units=units_of,
                       meta=meta)
-
-
-def _gauss_seidel_sources(seq: list[str], src_index: dict[str, list],
-                          plan: Plan) -> tuple[dict[str, list], dict[str, np.ndarray]]:
-    """Which inputs of each element read a value already at ``t_{k+1}`` when it steps in
-    Gauss-Seidel order: the output of an element stepped before it (in ``seq``) that does not
-    depend directly on an input still at ``t_k``. The same at every macro step, so found once.
-    Returns element -> [(source, its output positions, our input positions)] for those inputs
-    and element -> positions of the other connected inputs."""
-    fresh = {m: np.zeros(len(plan.outputs[m]), dtype=bool) for m in seq}
-    groups: dict[str, list] = {}
-    stale: dict[str, np.ndarray] = {}
-    for n in seq:
-        by_src: dict[str, tuple[list[int], list[int]]] = {}
-        rest = []
-        for j, s in enumerate(src_index[n]):
-            if s is None:
-                continue
-            if fresh[s[0]][s[1]]:
-                pair = by_src.setdefault(s[0], ([], []))
-                pair[0].append(s[1])
-                pair[1].append(j)
-            else:
-                rest.append(j)
-        groups[n] = [(src, np.array(a), np.array(b)) for src, (a, b) in by_src.items()]
-        stale[n] = np.array(rest, dtype=int)
-        # an output is at t_k+1 if every input it depends on directly is
-        fresh_in = {plan.inputs[n][j]: s is None or bool(fresh[s[0]][s[1]])
-                    for j, s in enumerate(src_index[n])}
-        fresh[n] = np.array([all(fresh_in.get(u, True) for u in plan.feedthrough[n].get(yn, []))
-                             for yn in plan.outputs[n]], dtype=bool)
-    return groups, stale
 
 
 def cosimulate(system: SystemStructure | str | Path, stop_time: float | None = None,
