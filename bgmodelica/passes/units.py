@@ -453,10 +453,9 @@ def _first(x: Any, one_unit: dict[int, tuple[Any, bool]]) -> Any:
         if x.node is None:
             items = x.items
             base = items.base if isinstance(items.base, np.ndarray) else items
-            known = one_unit.get(id(base))
-            if known is None:
-                known = one_unit[id(base)] = (base, _single_unit(base.ravel()))
-            if not known[1] and len({_leaf_key(leaf.sym) for leaf in items.ravel()}) > 1:
+            if id(base) not in one_unit:
+                one_unit[id(base)] = (base, _single_unit(base))
+            if not (one_unit[id(base)][1] or _single_unit(items)):
                 raise _Varies
             return items.flat[0]
         op, args = x.node
@@ -469,10 +468,9 @@ def _first(x: Any, one_unit: dict[int, tuple[Any, bool]]) -> Any:
 
 
 def _single_unit(leaves: np.ndarray) -> bool:
-    """Whether the leaves (declared scalars) all have one unit key (:func:`_leaf_key`);
-    False for an array that holds anything else."""
+    """Whether an array of leaves has one unit key (:func:`_leaf_key`); False otherwise."""
     try:
-        return len({_leaf_key(leaf.sym) for leaf in leaves}) <= 1
+        return len({_leaf_key(leaf.sym) for leaf in leaves.flat}) <= 1
     except AttributeError:
         return False
 
