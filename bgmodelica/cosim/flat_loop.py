@@ -15,7 +15,7 @@ from __future__ import annotations
 import ctypes
 import math
 from collections.abc import Callable
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -45,6 +45,24 @@ def _array_call(raw: Any, fmi_version: int) -> Any:
     if raw is None or fmi_version == 2:
         return raw
     return lambda inst, refs, n, values: raw(inst, refs, n, values, n)
+
+
+class _Element(NamedTuple):
+    """One unit as the loop calls it: its buffers, value references and C functions."""
+
+    name: str
+    unit: CoSimUnit
+    gather: np.ndarray          # positions of its inputs in z
+    in_buf: np.ndarray          # the unit's input buffer ...
+    in_refs: Any                # ... their value references, count and C pointer
+    n_in: int
+    in_ptr: Any
+    out_refs: Any               # output value references, count, C pointer into z
+    n_out: int
+    out_ptr: Any
+    set: Any                    # f(instance, refs, n, values): fmi2SetReal/fmi3SetFloat64
+    get: Any                    # the same for the getters
+    step: Any                   # fmi2DoStep, or None (FMI 3.0 steps through the unit)
 
 
 class FlatLoop:
@@ -85,21 +103,16 @@ class FlatLoop:
             self.idx[n] = idx
             u_off += m
         base = z.ctypes.data
-        # per element: (name, unit, input gather, the unit's input buffer, input refs, count,
-        # pointer to the buffer, output refs, count, pointer into z, raw set, get, and the
-        # raw fmi2DoStep or None: FMI 3.0 steps through the unit)
-        self.calls = []
+        self.calls: list[_Element] = []
         for n in names:
             unit = units[n]
-            raw = unit._raw
-            self.calls.append((
+            raw, version = unit._raw, unit.info.fmi_version
+            self.calls.append(_Element(
                 n, unit, self.idx[n], unit._u_buf, unit._u_vr, len(unit.input_names),
                 unit._u_ptr, unit._y_vr, len(unit.output_names),
-                ctypes.cast(base + 8 * y_off[n], _DOUBLE_P),
-                _array_call(raw.get("set"), unit.info.fmi_version),
-                _array_call(raw.get("get"), unit.info.fmi_version),
-                raw.get("step") if unit.info.fmi_version == 2 else None))
-        self.by_name = {c[0]: c for c in self.calls}
+                ctypes.cast(base + 8 * y_off[n], _DOUBLE_P), _array_call(raw.get("set"), version),
+                _array_call(raw.get("get"), version), raw.get("step") if version == 2 else None))
+        self.by_name = {c.name: c for c in self.calls}
         # a recorded row: per element its inputs, its outputs, then its extra variables
         row_idx, self.extra_cols = [], []
         col = 0
@@ -126,35 +139,35 @@ class FlatLoop:
         return spans
 
     def load(self, y: dict[str, np.ndarray]) -> None:
+        """Start from the outputs ``y`` (element -> values) read by the master."""
         for n in self.names:
             self.y[n][:] = y[n]
 
-    def _set(self, call: tuple, u: np.ndarray) -> None:
-        n, unit, _, buf, vr, m, ptr, *_ = call
-        if not m:
+    def _set(self, el: _Element, u: np.ndarray) -> None:
+        if not el.n_in:
             return
-        buf[:] = u
-        if call[10](unit.fmu.component, vr, m, ptr) > 1:
-            unit.set_inputs(u)                       # raises with the FMU's messages
+        el.in_buf[:] = u
+        if el.set(el.unit.fmu.component, el.in_refs, el.n_in, el.in_ptr) > 1:
+            el.unit.set_inputs(u)                    # raises with the FMU's messages
 
-    def _get(self, call: tuple) -> None:
-        m = call[8]
-        if m and call[11](call[1].fmu.component, call[7], m, call[9]) > 1:
-            self.y[call[0]][:] = call[1].get_outputs()   # raises with the FMU's messages
+    def _get(self, el: _Element) -> None:
+        if el.n_out and el.get(el.unit.fmu.component, el.out_refs, el.n_out, el.out_ptr) > 1:
+            self.y[el.name][:] = el.unit.get_outputs()   # raises with the FMU's messages
 
     def propagate(self, last: dict[str, np.ndarray]) -> None:
         """Re-evaluate the feedthrough outputs with the inputs of this instant (as
         ``propagate_outputs`` of the general loop: only where an input changed)."""
         z, by_name = self.z, self.by_name
-        for el in self.feed_order:
-            call = by_name[el]
-            u = z.take(call[2])
-            if u.tolist() != last[el].tolist():
-                self._set(call, u)
-                last[el] = u
-                self._get(call)
+        for name in self.feed_order:
+            el = by_name[name]
+            u = z.take(el.gather)
+            if u.tolist() != last[name].tolist():
+                self._set(el, u)
+                last[name] = u
+                self._get(el)
 
     def record(self, data: np.ndarray, row: int) -> None:
+        """Row ``row`` of ``data``: every element's inputs, outputs and extra variables."""
         if self.direct:
             self.z.take(self.row_idx, out=data[row])
             return
@@ -162,21 +175,20 @@ class FlatLoop:
         for n, a, b in self.extra_cols:
             data[row, a:b] = self.units[n].get(self.extra[n])
 
-    def _step(self, call: tuple, t: float, h: float, last: dict[str, np.ndarray]) -> bool:
+    def _step(self, el: _Element, t: float, h: float, last: dict[str, np.ndarray]) -> bool:
         """Set the element's inputs from ``z`` and step it from ``t`` to ``t + h``; True when
         the step did not succeed (the unit then says whether it terminated)."""
-        n, unit, idx, buf, vr, m, ptr = call[:7]
-        if m:
-            self.z.take(idx, out=buf)
-            if call[10](unit.fmu.component, vr, m, ptr) > 1:
+        unit, buf = el.unit, el.in_buf
+        if el.n_in:
+            self.z.take(el.gather, out=buf)
+            if el.set(unit.fmu.component, el.in_refs, el.n_in, el.in_ptr) > 1:
                 unit.set_inputs(buf.copy())          # raises with the FMU's messages
-        last[n] = buf.copy()
+        last[el.name] = buf.copy()
         unit.time = t
-        step = call[12]
-        if step is None:                             # FMI 3.0: early returns, terminate
+        if el.step is None:                          # FMI 3.0: early returns, terminate
             unit._step3(t, h)
             return unit.terminated
-        status = step(unit.fmu.component, t, h, 1)
+        status = el.step(unit.fmu.component, t, h, 1)
         if status <= 1:
             unit.time = t + h
             return False
@@ -204,19 +216,19 @@ class FlatLoop:
             t = t0 + k * h
             failed = False
             if ordered is None:                      # Jacobi: all step, then all are read
-                for call in calls:
-                    failed = step_one(call, t, h, last) or failed
-                for call in calls:
-                    get_one(call)
+                for el in calls:
+                    failed = step_one(el, t, h, last) or failed
+                for el in calls:
+                    get_one(el)
             else:                                    # Gauss-Seidel: each reads the newest
-                for call in ordered:
-                    failed = step_one(call, t, h, last) or failed
-                    get_one(call)
-                    if propagate and call[0] in feedthrough:
-                        u = z.take(call[2])
-                        self._set(call, u)
-                        last[call[0]] = u
-                        get_one(call)
+                for el in ordered:
+                    failed = step_one(el, t, h, last) or failed
+                    get_one(el)
+                    if propagate and el.name in feedthrough:
+                        u = z.take(el.gather)
+                        self._set(el, u)
+                        last[el.name] = u
+                        get_one(el)
             if propagate:
                 self.propagate(last)
             if failed:
