@@ -124,8 +124,16 @@ def sort_equations(reduced: ReducedModel) -> SortedDAE:
         take(model.stacked_variables(), [unknowns[b.vars[0]] for b in scalar]),
         remap_rows([eq_cols[e] for e in scalar_eqs], block_of_col) if scalar else [])
     has_discrete = any(v.decl.kind == "discrete" for v in variables)
-    var_hashes: set[int] = set()
     assignments, positions = out.assignments, out.positions
+    if not has_discrete and len(scalar) == len(blocks) and -1 not in position:
+        # every block an explicit assignment (most large models): no per-block dispatch
+        var_of_col = np.asarray(unknowns, dtype=np.int64)
+        assignments.extend(zip(var_of_col[[b.vars[0] for b in scalar]].tolist(), solved,
+                               strict=True))
+        positions.extend(position)
+        out.n_explicit = len(scalar)
+        return out
+    var_hashes: set[int] = set()
     k = -1                                      # position of the block among the scalar ones
     for block in blocks:
         eqs, cols = block.eqs, block.vars

@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import bgmodelica as bg
-from bgmodelica.passes.symbolic import LONG_ROW, _greedy_coloring, incidence
+from bgmodelica.passes.symbolic import LONG_ROW, _coloring, incidence
 from library.examples import RCLadder
 
 
@@ -43,30 +43,23 @@ def test_ground_balance_is_marked_long_and_compiles_as_without_the_split(monkeyp
     assert all((res[k] == ref[k]).all() for k in ref.names)
 
 
-def _reference_coloring(n, rows):
-    """Greedy coloring, written plainly: every pair in index order."""
-    neighbours = [set() for _ in range(n)]
-    for i, row in enumerate(rows):
-        for j in row:
-            if i != j:
-                neighbours[i].add(j)
-                neighbours[j].add(i)
-    color = [-1] * n
-    for k in range(n):
-        used = {color[j] for j in neighbours[k] if color[j] >= 0}
-        c = 0
-        while c in used:
-            c += 1
-        color[k] = c
-    return color
-
-
-@settings(max_examples=200, deadline=None)
-@given(st.integers(1, 25).flatmap(lambda n: st.lists(
-    st.lists(st.integers(0, n - 1), max_size=4), min_size=n, max_size=n)))
-def test_scalar_block_coloring_is_the_plain_greedy_one(rows):
+@settings(max_examples=300, deadline=None)
+@given(st.integers(1, 40).flatmap(lambda n: st.lists(
+    st.lists(st.integers(0, n - 1), max_size=5), min_size=n, max_size=n)))
+def test_scalar_block_coloring_separates_every_residual_from_its_other_variables(rows):
     n = len(rows)
-    color = _greedy_coloring(n, rows).tolist()
-    assert color == _reference_coloring(n, rows)
+    color = _coloring(n, rows).tolist()
+    assert min(color) == 0
     for i, row in enumerate(rows):          # no residual sees another variable of its color
         assert all(color[j] != color[i] for j in row if j != i)
+    alone = [i for i in range(n) if set(rows[i]) <= {i}
+             and all(i not in rows[k] for k in range(n) if k != i)]
+    assert all(color[i] == 0 for i in alone)      # no neighbours: the first color
+
+
+def test_a_long_chain_needs_few_colors_not_one_round_per_link():
+    n = 100_000
+    rows = [[k - 1, k] if k else [0] for k in range(n)]        # each needs the one before
+    color = _coloring(n, rows)
+    assert all(color[k] != color[k - 1] for k in range(1, n))
+    assert color.max() < 20
