@@ -218,11 +218,11 @@ def attach_initial_equations(dae: CasadiDAE, model) -> None:
         return
     res = ca.vertcat(*[e.residual for e in eqs])
     n_var = dae.n_variables or len(dae.names)
-    vsyms = [v.sx for v in dae.sorted.model.variables] if dae.sorted is not None else []
-    if len(vsyms) != n_var:
+    vsyms = dae.sorted.model.stacked_variables() if dae.sorted is not None else ca.SX(0, 1)
+    if vsyms.numel() != n_var:
         raise RuntimeError("initial equations: variables and observations do not match")
     obs = dae.observed[:n_var]
-    res = ca.substitute([res], [ca.vertcat(*vsyms)], [obs])[0] if vsyms else res
+    res = ca.substitute([res], [vsyms], [obs])[0] if vsyms.numel() else res
     if dae.bound:
         for _ in range(len(dae.bound)):               # bindings may chain
             bsym = ca.vertcat(*[q.sx for q in dae.bound])

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -19,14 +20,35 @@ class FlatVariable:
     component: dotted path of the component that declared it ("" for the top level).
     der_of / der: indices (in :attr:`FlatModel.variables`) linking a variable and its time
     derivative; -1 when absent.
+    sx: its SX scalar. Flattening binds the model's symbols as rows of one SX vector (the
+    ``at`` pair ``(vector, row)``) and the scalar is taken out on first use: a large model
+    then holds one vector instead of a Python object per scalar until a pass needs them.
     """
 
     name: str
-    sx: ca.SX
+    _sx: ca.SX | None
     decl: Declaration
     component: str
     der_of: int = -1
     der: int = -1
+    at: tuple[ca.SX, int] | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def sx(self) -> ca.SX:
+        sx = self._sx
+        if sx is None and self.at is not None:
+            column, row = self.at
+            sx = self._sx = column[row]
+        return sx
+
+    @sx.setter
+    def sx(self, value: ca.SX) -> None:
+        self._sx, self.at = value, None
+
+    def relinked(self, der_of: int, der: int) -> FlatVariable:
+        """A copy with other derivative links (the symbol stays as it is, bound or not)."""
+        return FlatVariable(self.name, self._sx, self.decl, self.component, der_of, der,
+                            self.at)
 
     @property
     def origin(self) -> str:
@@ -46,12 +68,27 @@ class FlatEquation:
     terms: number of variables of a long sum (a connection set's flow balance), 0 for an
     ordinary equation: passes keep long sums out of whole-model sparsity sweeps, whose cost
     grows with the number of rows times the longest expression.
+    residual: its SX scalar; like :attr:`FlatVariable.sx`, a row ``at = (column, row)`` of
+    the column it was lowered in until first used.
     """
 
-    residual: ca.SX
+    _residual: ca.SX | None
     origin: str
     alias: tuple[int, int, float] | None = None
     terms: int = 0
+    at: tuple[ca.SX, int] | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def residual(self) -> ca.SX:
+        res = self._residual
+        if res is None and self.at is not None:
+            column, row = self.at
+            res = self._residual = column[row]
+        return res
+
+    @residual.setter
+    def residual(self, value: ca.SX) -> None:
+        self._residual, self.at = value, None
 
     def describe(self, names: dict[int, str] | None = None, width: int = 100) -> str:
         """``0 = residual   [origin]`` with dotted names when ``names`` (hash -> name) given."""
@@ -183,6 +220,24 @@ class FlatModel:
 
     def parameter_values(self) -> dict[str, object]:
         return {p.name: p.decl.value for p in self.parameters}
+
+
+class Picked(Sequence):
+    """``getattr(items[idx[k]], attr)`` for each ``k``, read when asked for: the passes hand
+    these to helpers that take lists of scalars but use them only in rare branches, so that
+    a large model's symbols and residuals stay rows of their columns."""
+
+    __slots__ = ("items", "attr", "idx")
+
+    def __init__(self, items: Sequence[Any], attr: str, idx: Sequence[int] | None = None):
+        self.items, self.attr = items, attr
+        self.idx = range(len(items)) if idx is None else idx
+
+    def __len__(self) -> int:
+        return len(self.idx)
+
+    def __getitem__(self, k: int) -> Any:
+        return getattr(self.items[self.idx[k]], self.attr)
 
 
 def take(column: ca.SX, idx: list[int]) -> ca.SX:

@@ -243,20 +243,18 @@ class _Flattener(ConnectionLowering):
 
     def _bind(self, symbols) -> None:
         """Give every symbol an SX scalar: fresh ones become elements of one SX vector."""
-        fresh = [entry for entry in symbols if entry[0]._sx is None]
-        old = [entry for entry in symbols if entry[0]._sx is not None]
+        fresh = [entry for entry in symbols if not entry[0].bound]
+        old = [entry for entry in symbols if entry[0].bound]
         big = ca.SX.sym("v", len(fresh))
         pos = self.pos
-        for k, ((sym, target, index), sx) in enumerate(
-                zip(fresh, ca.vertsplit(big) if fresh else [], strict=True)):
-            sym._sx = sx                        # Symbol.bind, without a call per symbol
-            target[index].sx = sx
+        for k, (sym, target, index) in enumerate(fresh):
+            sym._at = target[index].at = (big, k)    # the scalar is taken out when used
             pos[id(sym)] = k
         for k, (sym, target, index) in enumerate(old, start=len(fresh)):
-            target[index].sx = sym._sx
+            target[index].sx = sym.sx
             pos[id(sym)] = k
         pos[id(TIME)] = len(fresh) + len(old)
-        self.all_sx = ca.vertcat(big, *[entry[0]._sx for entry in old], TIME.sx)
+        self.all_sx = ca.vertcat(big, *[entry[0].sx for entry in old], TIME.sx)
 
     def _lower_binding(self, p: FlatVariable) -> FlatVariable:
         if isinstance(p.decl.value, Expr):
@@ -338,29 +336,28 @@ class _Flattener(ConnectionLowering):
         lhs = lower_group(shape_l, leaf_vecs[:n_l], const_vecs[:c_l])
         rhs = lower_group(shape_r, leaf_vecs[n_l:], const_vecs[c_l:])
         res = ca.SX(lhs - rhs)
-        parts = ca.vertsplit(res) if len(members) > 1 else [res]
         signs = alias_signs(shape_l, shape_r)
         if signs:
-            for r, (leaves, consts, where, _) in zip(parts, members, strict=True):
+            for k, (leaves, consts, where, _) in enumerate(members):
                 alias = None if any(consts) else \
                     self._alias_of(signs[0], leaves[0], signs[1], leaves[1])
-                self.equations.append(FlatEquation(r, where, alias))
+                self.equations.append(FlatEquation(None, where, alias, at=(res, k)))
         else:
-            self.equations.extend(FlatEquation(r, m[2]) for r, m in zip(parts, members,
-                                                                        strict=True))
+            self.equations.extend(FlatEquation(None, m[2], at=(res, k))
+                                  for k, m in enumerate(members))
         self.columns.append(res)
 
     def _lower_block(self, eq: ArrayEquation, where: str) -> None:
         """One array equation as one residual column (:mod:`.flatten_arrays`)."""
         res, size = flatten_arrays.residual(eq, where, self.pos, self.all_sx, self._alien)
-        parts = ca.vertsplit(res) if size > 1 else [res]
         pairs = flatten_arrays.alias_pairs(eq)
         if pairs is None:
-            self.equations.extend(FlatEquation(r, where) for r in parts)
+            self.equations.extend(FlatEquation(None, where, at=(res, k)) for k in range(size))
         else:
             sa, sb, a, b = pairs
-            self.equations.extend(FlatEquation(r, where, self._alias_of(sa, la.sym, sb, lb.sym))
-                                  for r, la, lb in zip(parts, a, b, strict=True))
+            self.equations.extend(
+                FlatEquation(None, where, self._alias_of(sa, la.sym, sb, lb.sym), at=(res, k))
+                for k, (la, lb) in enumerate(zip(a, b, strict=True)))
         self.columns.append(res)
 
     def _alien(self, sym: Any, eq: Any, where: str) -> EquationError:

@@ -111,9 +111,8 @@ class ConnectionLowering:
             # would not (the sparsity is sorted column-major)
             sel = ca.DM.triplet(rows, cols, ca.DM(vals), len(pairs.sums), self.all_sx.numel())
             totals = ca.mtimes(sel, self.all_sx)
-            parts = ca.vertsplit(totals) if len(pairs.sums) > 1 else [totals]
-            for total, (syms, _, origin) in zip(parts, pairs.sums, strict=True):
-                self.equations.append(FlatEquation(total, origin, terms=len(syms)))
+            self.equations.extend(FlatEquation(None, origin, terms=len(syms), at=(totals, k))
+                                  for k, (syms, _, origin) in enumerate(pairs.sums))
             self.columns.append(totals)
         if not pairs.a:
             return
@@ -124,9 +123,10 @@ class ConnectionLowering:
         va = [var_of(id(s)) for s in pairs.a]
         vb = [var_of(id(s)) for s in pairs.b]
         self.equations.extend(
-            FlatEquation(r, origin, (a, b, -c) if a is not None and b is not None else None)
-            for r, origin, a, b, c in zip(ca.vertsplit(res), pairs.origin, va, vb, pairs.coef,
-                                          strict=True))
+            FlatEquation(None, origin, (a, b, -c) if a is not None and b is not None else None,
+                         at=(res, k))
+            for k, (origin, a, b, c) in enumerate(zip(pairs.origin, va, vb, pairs.coef,
+                                                      strict=True)))
         self.columns.append(res)
 
 

@@ -219,14 +219,15 @@ class Symbol:
     ``der`` (the Symbol of its time derivative).
     """
 
-    __slots__ = ("name", "decl", "_sx", "owner", "der", "der_of", "pre", "pre_of", "leaf",
-                 "__weakref__")
+    __slots__ = ("name", "decl", "_sx", "_at", "owner", "der", "der_of", "pre", "pre_of",
+                 "leaf", "__weakref__")
 
     def __init__(self, name: str, decl: Declaration, owner: Any, der_of: Symbol | None = None,
                  pre_of: Symbol | None = None):
         self.name = name
         self.decl = decl
         self._sx: ca.SX | None = None
+        self._at: tuple[ca.SX, int] | None = None    # (vector, row) bound by flattening
         self.owner = owner
         self.der: Symbol | None = None
         self.der_of = der_of
@@ -236,11 +237,22 @@ class Symbol:
 
     @property
     def sx(self) -> ca.SX:
-        """The SX scalar of this symbol (created on first use)."""
-        if self._sx is None:
-            self._sx = ca.SX.sym(self.name)
-            _REGISTRY[self._sx.element_hash()] = self
-        return self._sx
+        """The SX scalar of this symbol: an element of the vector flattening bound it to, or
+        a fresh symbol (created on first use)."""
+        sx = self._sx
+        if sx is None:
+            if self._at is not None:
+                column, row = self._at
+                sx = self._sx = column[row]
+            else:
+                sx = self._sx = ca.SX.sym(self.name)
+                _REGISTRY[sx.element_hash()] = self
+        return sx
+
+    @property
+    def bound(self) -> bool:
+        """Whether the symbol has its SX scalar (or flattening has bound it to a row)."""
+        return self._sx is not None or self._at is not None
 
     def derivative(self) -> Symbol:
         """The symbol of this variable's time derivative (created once)."""

@@ -69,7 +69,6 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
                         *[v.sx for v in new_vars[len(variables):]])
     kept_idx = _complement(len(model.equations), used)
     kept = [model.equations[k] for k in kept_idx]
-    residuals: list[ca.SX] = []
     kept_column = None
     hybrid = model.hybrid
     extra = hybrid.expressions() if hybrid is not None else []
@@ -80,15 +79,15 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
         if old:
             targets = ca.substitute(targets, take(column, old),
                                     take(column, new_rep) * ca.DM(new_sign))
-        parts = ca.vertsplit(targets) if targets.numel() > 1 else [targets]
-        residuals = parts[:len(kept)]
         kept_column = targets[:len(kept)]
+        rest = targets[len(kept):]
+        parts = ca.vertsplit(rest) if rest.numel() > 1 else [rest] if extra else []
         initial = [FlatEquation(r, eq.origin) for r, eq in
-                   zip(parts[len(kept):len(kept) + n_init], model.initial_equations, strict=True)]
+                   zip(parts[:n_init], model.initial_equations, strict=True)]
         if hybrid is not None:
-            hybrid = hybrid.with_expressions(parts[len(kept) + n_init:])
-    equations = [FlatEquation(res, eq.origin, terms=eq.terms)
-                 for res, eq in zip(residuals, kept, strict=True)]
+            hybrid = hybrid.with_expressions(parts[n_init:])
+    equations = [FlatEquation(None, eq.origin, terms=eq.terms, at=(kept_column, k))
+                 for k, eq in enumerate(kept)]
     keep_idx = _complement(len(new_vars), eliminated)
     remap_of = np.full(len(new_vars) + 1, -1)    # old index -> new; remap[-1] stays -1
     remap_of[keep_idx] = np.arange(len(keep_idx))
@@ -99,8 +98,7 @@ def eliminate_aliases(model: FlatModel) -> FlatModel:
         if v.der < 0 and v.der_of < 0:
             final.append(v)                        # no derivative links to renumber
         else:
-            final.append(FlatVariable(v.name, v.sx, v.decl, v.component,
-                                      der_of=remap[v.der_of], der=remap[v.der]))
+            final.append(v.relinked(remap[v.der_of], remap[v.der]))
     out = FlatModel(model.name, final, model.parameters, model.inputs, equations, aliases,
                     model.discretes, hybrid)
     out.initial_equations = initial if n_init else []

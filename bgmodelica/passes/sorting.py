@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
-from ..core.flatmodel import take
+from ..core.flatmodel import Picked, take
 from ..diagnose import singular_linear_block
 from ..errors import EquationError, UnbalancedModelError
 from ..structure import block_lower_triangular, compiled, maximum_matching, tear
@@ -109,8 +109,8 @@ def sort_equations(reduced: ReducedModel) -> SortedDAE:
             + "\n" + "\n".join(f"  surplus: {e}" for e in bad_eqs[:12]),
             missing=bad_vars, surplus=bad_eqs)
 
-    res = [e.residual for e in model.equations]
-    sym = [variables[j].sx for j in unknowns]
+    res = Picked(model.equations, "residual")
+    sym = Picked(variables, "sx", unknowns)
     out = SortedDAE(reduced, [], [], [], [])
     blocks = block_lower_triangular(eq_cols, len(unknowns), matching)
     scalar = [b for b in blocks if len(b.eqs) == 1]
@@ -118,7 +118,8 @@ def sort_equations(reduced: ReducedModel) -> SortedDAE:
     block_of_col = np.full(len(unknowns), -1, dtype=np.int64)  # unknown -> its scalar block
     block_of_col[[b.vars[0] for b in scalar]] = np.arange(len(scalar))
     solved, out.solution_column, position = solve_scalar_blocks(
-        [res[e] for e in scalar_eqs], [sym[b.vars[0]] for b in scalar],
+        Picked(model.equations, "residual", scalar_eqs),
+        Picked(variables, "sx", [unknowns[b.vars[0]] for b in scalar]),
         {k for k, e in enumerate(scalar_eqs) if model.equations[e].terms > LONG_ROW},
         take(model.stacked_residuals(), scalar_eqs),
         take(model.stacked_variables(), [unknowns[b.vars[0]] for b in scalar]),

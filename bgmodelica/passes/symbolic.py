@@ -8,6 +8,8 @@ from itertools import chain
 import casadi as ca
 import numpy as np
 
+from ..core.flatmodel import Picked
+
 #: a sum over more terms than this is a long row (see :func:`incidence`)
 LONG_ROW = 64
 
@@ -41,7 +43,7 @@ def _incidence(residuals: Sequence[ca.SX], symbols: Sequence[ca.SX], stacked: ca
     if not long:
         expr = stacked if stacked is not None else ca.vertcat(*residuals)
         return _sparsity_rows(expr, sym_vec)
-    rows: list[list[int]] = [[] for _ in residuals]
+    rows: list[list[int]] = [[] for _ in range(len(residuals))]
     ordered = sorted(long)                     # their own pass: few rows, one sweep each 64
     short = [k for k in range(len(residuals)) if k not in long]
     for part in (ordered, short):
@@ -74,8 +76,8 @@ def model_incidence(model) -> list[list[int]]:
     elif not model.variables:
         rows = [[] for _ in model.equations]
     else:
-        rows = _incidence([e.residual for e in model.equations],
-                          [v.sx for v in model.variables], model.stacked_residuals(),
+        rows = _incidence(Picked(model.equations, "residual"),
+                          Picked(model.variables, "sx"), model.stacked_residuals(),
                           model.stacked_variables(), long_rows(model.equations))
     model.__dict__["_incidence_memo"] = (key, rows)
     return rows
