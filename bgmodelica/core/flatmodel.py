@@ -39,6 +39,7 @@ class FlatVariable:
         if sx is None and self.at is not None:
             column, row = self.at
             sx = self._sx = column[row]
+            self.at = None                  # the column may go (and is not pickled)
         return sx
 
     @sx.setter
@@ -84,6 +85,7 @@ class FlatEquation:
         if res is None and self.at is not None:
             column, row = self.at
             res = self._residual = column[row]
+            self.at = None
         return res
 
     @residual.setter

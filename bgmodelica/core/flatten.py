@@ -13,6 +13,7 @@ from dataclasses import replace
 from typing import Any
 
 import casadi as ca
+import numpy as np
 
 from ..errors import ConnectError, DeclarationError, EquationError
 from ..validate import check_binding, check_sx_binding, guarded_equations
@@ -66,6 +67,7 @@ class _Flattener(ConnectionLowering):
         self.groups: dict[Any, list] = {}         # equation shape -> members (as written)
         self.blocks: list[tuple[ArrayEquation, str]] = []   # array equations lowered whole
         self.initial_sources: list[tuple[Equation, str]] = []   # initial equations as written
+        self.array_rows: dict[int, Any] = {}      # declared arrays' rows (flatten_arrays)
 
     # -- tree walk -------------------------------------------------------------------------
     def run(self, name: str) -> FlatModel:
@@ -103,7 +105,6 @@ class _Flattener(ConnectionLowering):
         self._component_equations()
         initial = self._initial_equations()
         sources = self._sources(parameters)
-        declared = parameters
         parameters = [p if type(p.decl.value) is float else self._lower_binding(p)
                       for p in parameters]
         hybrid = None
@@ -114,9 +115,7 @@ class _Flattener(ConnectionLowering):
                          discretes=discretes, hybrid=hybrid, sources=sources,
                          initial_equations=initial)
         flat.remember_stacked(ca.vertcat(*self.columns) if self.columns else None,
-                              *[take(self.all_sx, [self.pos[id(sym)] for sym, target, _ in symbols
-                                                   if target is kind])
-                                for kind in (variables, declared)])
+                              *[take(self.all_sx, self._rows(entries)) for entries in self.entries])
         return flat
 
     def _initial_equations(self) -> list[FlatEquation]:
@@ -184,16 +183,20 @@ class _Flattener(ConnectionLowering):
 
     # -- symbols ---------------------------------------------------------------------------
     def _collect_symbols(self):
+        """Every symbol of the tree with its flat variable, in tree order; also records
+        where in that list the unknowns and the parameters are (``entries``)."""
         variables: list[FlatVariable] = []
         parameters: list[FlatVariable] = []
         inputs: list[FlatVariable] = []
         discretes: list[FlatVariable] = []
-        symbols: list[tuple[Symbol, list, int]] = []      # (symbol, target list, index)
+        symbols: list[tuple[Symbol, FlatVariable]] = []
+        var_entries: list[int] = []                       # positions in symbols, by kind
+        par_entries: list[int] = []
         hybrid = self.draft is not None
         targets = self.draft.targets if hybrid else {}
         top_connectors = {id(c) for c in self.top._children.values() if isinstance(c, Connector)}
         full_names, var_of, paths = self.full, self.var_of, self.paths
-        add_symbol, add_variable = symbols.append, variables.append
+        add_symbol, add_variable, add_entry = symbols.append, variables.append, var_entries.append
         for elem in self.elements:
             path = paths[id(elem)]
             owner = path if isinstance(elem, Component) else path.rpartition(".")[0]
@@ -206,25 +209,33 @@ class _Flattener(ConnectionLowering):
                 full_names[id(sym)] = full
                 if hybrid and id(sym) in targets:
                     self.slot[id(sym)] = len(discretes)
-                    add_symbol((sym, discretes, len(discretes)))
-                    discretes.append(FlatVariable(full, None, decl, owner))
+                    fv = FlatVariable(full, None, decl, owner)
+                    add_symbol((sym, fv))
+                    discretes.append(fv)
                 elif kind == KIND_PARAMETER:
-                    add_symbol((sym, parameters, len(parameters)))
-                    parameters.append(FlatVariable(full, None, decl, owner))
+                    fv = FlatVariable(full, None, decl, owner)
+                    par_entries.append(len(symbols))
+                    add_symbol((sym, fv))
+                    parameters.append(fv)
                 elif kind == KIND_INPUT and top_level:
-                    add_symbol((sym, inputs, len(inputs)))
-                    inputs.append(FlatVariable(full, None, decl, owner))
+                    fv = FlatVariable(full, None, decl, owner)
+                    add_symbol((sym, fv))
+                    inputs.append(fv)
                 else:
                     below = len(variables)
                     var_of[id(sym)] = below
-                    add_symbol((sym, variables, below))
-                    add_variable(FlatVariable(full, None, decl, owner))
+                    fv = FlatVariable(full, None, decl, owner)
+                    add_entry(len(symbols))
+                    add_symbol((sym, fv))
+                    add_variable(fv)
                     while sym.der is not None:             # derivative chain
                         sym, full = sym.der, f"der({full})"
-                        variables[below].der = len(variables)
+                        fv.der = len(variables)
                         var_of[id(sym)] = len(variables)
-                        symbols.append((sym, variables, len(variables)))
-                        variables.append(FlatVariable(full, None, sym.decl, owner, der_of=below))
+                        fv = FlatVariable(full, None, sym.decl, owner, der_of=below)
+                        add_entry(len(symbols))
+                        add_symbol((sym, fv))
+                        add_variable(fv)
                         below = len(variables) - 1
         if self.draft is not None:
             for k, sym in enumerate(self.draft.hidden()):
@@ -237,24 +248,43 @@ class _Flattener(ConnectionLowering):
                 else:
                     name = _hidden_name(sym, k)
                 self.slot[id(sym)] = len(discretes)
-                symbols.append((sym, discretes, len(discretes)))
-                discretes.append(FlatVariable(name, None, sym.decl, ""))
+                fv = FlatVariable(name, None, sym.decl, "")
+                symbols.append((sym, fv))
+                discretes.append(fv)
+        self.entries = (var_entries, par_entries)
         return variables, parameters, inputs, discretes, symbols
 
     def _bind(self, symbols) -> None:
-        """Give every symbol an SX scalar: fresh ones become elements of one SX vector."""
-        fresh = [entry for entry in symbols if not entry[0].bound]
-        old = [entry for entry in symbols if entry[0].bound]
+        """Give every symbol an SX scalar: fresh ones become rows of one SX vector (taken out
+        when first used), symbols bound before (a model flattened again) keep theirs and
+        follow. ``rows``: the row in :attr:`all_sx` of each entry of ``symbols``."""
+        old = [k for k, (sym, _) in enumerate(symbols)
+               if sym._sx is not None or sym._at is not None]
+        fresh = symbols
+        self.rows = None                                  # entry k is row k
+        if old:
+            is_old = np.zeros(len(symbols), dtype=bool)
+            is_old[old] = True
+            order = np.concatenate((np.flatnonzero(~is_old), old)).astype(np.int64)
+            rows = np.empty(len(symbols), dtype=np.int64)
+            rows[order] = np.arange(len(symbols))
+            self.rows = rows
+            fresh = [symbols[k] for k in order[:len(symbols) - len(old)].tolist()]
         big = ca.SX.sym("v", len(fresh))
         pos = self.pos
-        for k, (sym, target, index) in enumerate(fresh):
-            sym._at = target[index].at = (big, k)    # the scalar is taken out when used
+        for k, (sym, fv) in enumerate(fresh):
+            sym._at = fv.at = (big, k)                    # the scalar is taken out when used
             pos[id(sym)] = k
-        for k, (sym, target, index) in enumerate(old, start=len(fresh)):
-            target[index].sx = sym.sx
+        olds = [symbols[k] for k in old]
+        for k, (sym, fv) in enumerate(olds, start=len(fresh)):
+            fv.sx = sym.sx
             pos[id(sym)] = k
-        pos[id(TIME)] = len(fresh) + len(old)
-        self.all_sx = ca.vertcat(big, *[entry[0].sx for entry in old], TIME.sx)
+        pos[id(TIME)] = len(symbols)
+        self.all_sx = ca.vertcat(big, *[sym.sx for sym, _ in olds], TIME.sx)
+
+    def _rows(self, entries: list[int]) -> list[int]:
+        """Rows in :attr:`all_sx` of the symbols at ``entries`` of the collected list."""
+        return entries if self.rows is None else self.rows[entries].tolist()
 
     def _lower_binding(self, p: FlatVariable) -> FlatVariable:
         if isinstance(p.decl.value, Expr):
@@ -349,7 +379,8 @@ class _Flattener(ConnectionLowering):
 
     def _lower_block(self, eq: ArrayEquation, where: str) -> None:
         """One array equation as one residual column (:mod:`.flatten_arrays`)."""
-        res, size = flatten_arrays.residual(eq, where, self.pos, self.all_sx, self._alien)
+        res, size = flatten_arrays.residual(eq, where, self.pos, self.all_sx, self._alien,
+                                            self.array_rows)
         pairs = flatten_arrays.alias_pairs(eq)
         if pairs is None:
             self.equations.extend(FlatEquation(None, where, at=(res, k)) for k in range(size))

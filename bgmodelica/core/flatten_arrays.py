@@ -23,9 +23,10 @@ Alien = Callable[[Any, Any, str], EquationError]
 
 
 def residual(eq: ArrayEquation, where: str, pos: dict[int, int], symbols: ca.SX,
-             alien: Alien) -> tuple[ca.SX, int]:
+             alien: Alien, memo: dict[int, Any] | None = None) -> tuple[ca.SX, int]:
     """``lhs - rhs`` of ``eq`` as one column of its scalar equations (C order) and their
-    number; ``pos`` maps ``id(symbol)`` to its row in ``symbols``."""
+    number; ``pos`` maps ``id(symbol)`` to its row in ``symbols``; ``memo`` (one per
+    flattening) keeps the rows of each declared array for the next equation using it."""
     shape = eq.shape
     size = int(np.prod(shape))
     found: list[bool] = []
@@ -33,10 +34,10 @@ def residual(eq: ArrayEquation, where: str, pos: dict[int, int], symbols: ca.SX,
     def lower(x: Any, want: tuple[int, ...]) -> Any:
         if isinstance(x, ArrayExpr):
             if x.node is None:
-                items = x.items.ravel()
                 try:
-                    idx = [pos[id(leaf.sym)] for leaf in items]
+                    idx = _rows(x.items, pos, {} if memo is None else memo)
                 except KeyError:
+                    items = x.items.ravel()
                     sym = next(leaf.sym for leaf in items if id(leaf.sym) not in pos)
                     raise alien(sym, eq, where) from None
                 found.append(True)
@@ -63,6 +64,33 @@ def residual(eq: ArrayEquation, where: str, pos: dict[int, int], symbols: ca.SX,
     if res.numel() != size:
         res = ca.repmat(res, size, 1)
     return res, size
+
+
+def _rows(items: np.ndarray, pos: dict[int, int], memo: dict[int, Any]) -> list[int]:
+    """Rows of an array of declared scalars (C order). A declared array's rows are read
+    once; a slice or transpose of it (a numpy view) takes its rows by the same offset and
+    strides (object and int64 elements are both 8 bytes)."""
+    base = items
+    while isinstance(base.base, np.ndarray):
+        base = base.base
+    if base is items and items.size < 64 or not base.flags.c_contiguous \
+            or base.itemsize != 8:
+        return [pos[id(leaf.sym)] for leaf in items.ravel()]
+    hit = memo.get(id(base))
+    if hit is None:
+        try:
+            rows = np.fromiter((pos[id(leaf.sym)] for leaf in base.ravel()), np.int64,
+                               base.size)
+        except (KeyError, AttributeError):        # not all of the base is declared scalars
+            rows = None
+        hit = memo[id(base)] = (base, rows)       # holding base keeps its id unique
+    if hit[1] is None:
+        return [pos[id(leaf.sym)] for leaf in items.ravel()]
+    offset = (items.__array_interface__["data"][0]
+              - base.__array_interface__["data"][0]) // 8
+    view = np.lib.stride_tricks.as_strided(hit[1][offset:], shape=items.shape,
+                                           strides=items.strides, writeable=False)
+    return view.ravel().tolist()
 
 
 def alias_pairs(eq: ArrayEquation) -> tuple[float, float, np.ndarray, np.ndarray] | None:

@@ -244,6 +244,7 @@ class Symbol:
             if self._at is not None:
                 column, row = self._at
                 sx = self._sx = column[row]
+                self._at = None
             else:
                 sx = self._sx = ca.SX.sym(self.name)
                 _REGISTRY[sx.element_hash()] = self

@@ -67,3 +67,31 @@ def test_picked_reads_the_attribute_of_the_chosen_items_only_when_asked():
     assert len(picked) == 2 and Item.reads == 0
     assert picked[1] == 2.0 and Item.reads == 1
     assert len(Picked(items, "value")) == 5
+
+
+def test_rows_of_slices_and_transposes_of_a_declared_array_are_read_by_strides():
+    from bgmodelica.core.flatten_arrays import _rows
+
+    class Leaf:
+        def __init__(self):
+            self.sym = object()
+
+    base = np.empty(120, dtype=object)
+    base[:] = [Leaf() for _ in range(120)]
+    pos = {id(leaf.sym): 1000 + 7 * k for k, leaf in enumerate(base)}
+    memo: dict = {}
+    grid = base.reshape(12, 10)
+    for view in (base, base[1:], base[:-1], base[::-3], base[5:90:4], grid.T, grid[3:, ::2].T,
+                 grid[::-1, 2:7]):
+        assert _rows(view, pos, memo) == [pos[id(leaf.sym)] for leaf in view.ravel()]
+    mixed = base.copy()
+    mixed[-1] = 3.0                                   # not all declared scalars: read directly
+    assert _rows(mixed[:70], pos, memo) == [pos[id(leaf.sym)] for leaf in mixed[:70]]
+    del pos[id(base[4].sym)]
+    fresh: dict = {}
+    try:
+        _rows(base[2:], pos, fresh)
+    except KeyError:
+        pass
+    else:
+        raise AssertionError("a symbol outside the model must not get a row")
