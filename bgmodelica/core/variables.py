@@ -250,11 +250,6 @@ class Symbol:
                 _REGISTRY[sx.element_hash()] = self
         return sx
 
-    @property
-    def bound(self) -> bool:
-        """Whether the symbol has its SX scalar (or flattening has bound it to a row)."""
-        return self._sx is not None or self._at is not None
-
     def derivative(self) -> Symbol:
         """The symbol of this variable's time derivative (created once)."""
         if self.decl.kind == KIND_PARAMETER:
