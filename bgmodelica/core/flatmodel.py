@@ -11,6 +11,29 @@ import casadi as ca
 from .variables import Declaration, StateSelect
 
 
+class _Row:
+    """An SX scalar attribute kept as row ``at = (column, row)`` of a column until first
+    read, then stored in ``slot``; the column is let go (and not pickled with it)."""
+
+    def __init__(self, slot: str) -> None:
+        self.slot = slot
+
+    def __get__(self, obj: Any, owner: type | None = None) -> Any:
+        if obj is None:
+            return self
+        value = getattr(obj, self.slot)
+        if value is None and obj.at is not None:
+            column, row = obj.at
+            value = column[row]
+            setattr(obj, self.slot, value)
+            obj.at = None
+        return value
+
+    def __set__(self, obj: Any, value: ca.SX) -> None:
+        setattr(obj, self.slot, value)
+        obj.at = None
+
+
 @dataclass(slots=True)
 class FlatVariable:
     """One scalar of the flat model.
@@ -32,19 +55,7 @@ class FlatVariable:
     der_of: int = -1
     der: int = -1
     at: tuple[ca.SX, int] | None = field(default=None, repr=False, compare=False)
-
-    @property
-    def sx(self) -> ca.SX:
-        sx = self._sx
-        if sx is None and self.at is not None:
-            column, row = self.at
-            sx = self._sx = column[row]
-            self.at = None                  # the column may go (and is not pickled)
-        return sx
-
-    @sx.setter
-    def sx(self, value: ca.SX) -> None:
-        self._sx, self.at = value, None
+    sx = _Row("_sx")
 
     def relinked(self, der_of: int, der: int) -> FlatVariable:
         """A copy with other derivative links (the symbol stays as it is, bound or not)."""
@@ -78,19 +89,7 @@ class FlatEquation:
     alias: tuple[int, int, float] | None = None
     terms: int = 0
     at: tuple[ca.SX, int] | None = field(default=None, repr=False, compare=False)
-
-    @property
-    def residual(self) -> ca.SX:
-        res = self._residual
-        if res is None and self.at is not None:
-            column, row = self.at
-            res = self._residual = column[row]
-            self.at = None
-        return res
-
-    @residual.setter
-    def residual(self, value: ca.SX) -> None:
-        self._residual, self.at = value, None
+    residual = _Row("_residual")
 
     def describe(self, names: dict[int, str] | None = None, width: int = 100) -> str:
         """``0 = residual   [origin]`` with dotted names when ``names`` (hash -> name) given."""
