@@ -37,6 +37,7 @@ def run(n: int) -> dict[str, float]:
     return {"n": n, "construct": t1 - t0, "compile": t2 - t1, "build": t2 - t0,
             "solve": t3 - t2, "total": t3 - t0, "states": len(compiled.dae.state_names),
             "steps": result.meta["stats"].get("n_step", float("nan")),
+            "first_final": float(result["C1.v"][-1]), "last_final": float(result[f"C{n}.v"][-1]),
             **{f"stage_{k}": v for k, v in compiled.timings.items()}}
 
 
