@@ -167,8 +167,7 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
     run = _time.perf_counter() - t_start
     names = [dae.names[k] for k in obs_idx]
     flat = compiled.reduced.model
-    units = {v.name: v.decl.unit for v in flat.variables}
-    units.update({q.name: q.decl.unit for q in (*flat.parameters, *flat.inputs)})
+    units = _units_by_name(dae, flat)
     params_out = dae.parameter_values(p)
     meta = {"compile_seconds": compiled.compile_time, "run_seconds": run,
             "timings": dict(compiled.timings), "solver": solver, "solver_choice": choice,
@@ -176,7 +175,7 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
             "states": list(dae.state_names), "init_notes": init.notes}
     kept = set(names)
     aliases = {a: rep for a, rep in flat.aliases.items() if rep[0] in kept}
-    result = Result(grid[:n_ok], values, names, aliases, params_out, units, meta)
+    result = Result(grid[:n_ok], values, names, aliases, params_out, dict(units), meta)
     if not _finite_run(dae, obs_idx, grid[:n_ok], xs, zs, p):
         check_result(result, dae, p)            # names the variable and time
     if failure is not None:
@@ -187,6 +186,17 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
             f"{hint}.\nSolver said: {failure.strip().splitlines()[-1][:300]}",
             t_reached, result)
     return result
+
+
+def _units_by_name(dae: CasadiDAE, flat: Any) -> dict[str, str]:
+    """The declared unit of every variable, parameter and input of the flat model, by name;
+    made once per model (kept in ``dae.cache``)."""
+    seen = dae.cache.get("units by name")
+    if seen is None or seen[0] is not flat:
+        units = {v.name: v.decl.unit for v in flat.variables}
+        units.update({q.name: q.decl.unit for q in (*flat.parameters, *flat.inputs)})
+        seen = dae.cache["units by name"] = (flat, units)
+    return seen[1]
 
 
 def _finite_run(dae: CasadiDAE, obs_idx: list[int], times: np.ndarray, xs: np.ndarray,

@@ -187,6 +187,11 @@ def _bounds(decl: Any) -> tuple[float | None, float | None]:
     return (None if lo is None else float(lo)), (None if hi is None else float(hi))
 
 
+def _bound(decl: Any, side: str, none: float) -> float:
+    value = getattr(decl, side, None)
+    return none if value is None else float(value)
+
+
 def _has_bounds(decl: Any) -> bool:
     return getattr(decl, "min", None) is not None or getattr(decl, "max", None) is not None
 
@@ -209,24 +214,27 @@ def _check_one(kind: str, name: str, value: float, decl: Any, where: str) -> Non
 def check_values(dae: Any, p: np.ndarray, flat: Any = None) -> None:
     """Parameters, inputs and fixed start values: finite and inside their declared
     ``min``/``max``. ``flat`` (the reduced flat model) supplies parameters bound to
-    expressions of others and the declarations of the variables."""
+    expressions of others and the declarations of the variables. The parameters and inputs
+    are checked in numpy against bounds kept in ``dae.cache``; the start values, fixed when
+    the model was compiled, are checked once per model."""
     import casadi as ca
 
     p = np.asarray(p, dtype=float)
-    n_par = len(dae.parameters)
-    finite = np.isfinite(p).tolist()
-    values = p.tolist()
-    for k, q in enumerate(dae.parameters):
-        if not finite[k] or _has_bounds(q.decl):
-            _check_one("parameter", q.name, values[k], q.decl, _declared(q))
-    for k, u in enumerate(dae.inputs):
-        if not finite[n_par + k] or _has_bounds(u.decl):
-            _check_one("input", u.name, values[n_par + k], u.decl, _declared(u))
-    bad = [d.name for k, d in enumerate(getattr(dae, "discretes", ()))
-           if not math.isfinite(float(p[n_par + len(dae.inputs) + k]))
-           and not d.name.startswith("$")]
-    if bad:
-        raise ParameterError(f"discrete variable {bad[0]} starts at a non-finite value")
+    n_par, n_in = len(dae.parameters), len(dae.inputs)
+    lo, hi = _value_bounds(dae)
+    head = p[:n_par + n_in]
+    with np.errstate(invalid="ignore"):
+        bad = ~np.isfinite(head) | (head < lo) | (head > hi)
+    for k in np.flatnonzero(bad).tolist():          # the first one raises
+        kind, q = ("parameter", dae.parameters[k]) if k < n_par \
+            else ("input", dae.inputs[k - n_par])
+        _check_one(kind, q.name, float(head[k]), q.decl, _declared(q))
+    bad_discrete = [d.name for k, d in enumerate(getattr(dae, "discretes", ()))
+                    if not math.isfinite(float(p[n_par + n_in + k]))
+                    and not d.name.startswith("$")]
+    if bad_discrete:
+        raise ParameterError(f"discrete variable {bad_discrete[0]} starts at a non-finite "
+                             "value")
     if flat is not None:
         bound = [q for q in flat.parameters if isinstance(q.decl.value, ca.SX)]
         if bound:
@@ -236,6 +244,29 @@ def check_values(dae: Any, p: np.ndarray, flat: Any = None) -> None:
                     comp = f", declared in {q.component}" if q.component else ""
                     _check_one("parameter", q.name, v, q.decl,
                                f" (bound to other parameters{comp})")
+    # a DAE copied with other start values (dataclasses.replace) shares the cache: the
+    # entries remember which objects they were made for
+    key = ("starts checked", flat is not None)
+    made_for = (dae.fixed, dae.x_start, dae.z_start)
+    seen = dae.cache.get(key)
+    if seen is None or any(a is not b for a, b in zip(seen, made_for, strict=True)):
+        _check_starts(dae, flat)
+        dae.cache[key] = made_for
+
+
+def _value_bounds(dae: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Declared ``min``/``max`` of the parameters then the inputs (-inf/inf: none)."""
+    seen = dae.cache.get("value bounds")
+    if seen is None or seen[0] is not dae.parameters or seen[1] is not dae.inputs:
+        decls = [q.decl for q in (*dae.parameters, *dae.inputs)]
+        lo = np.array([_bound(d, "min", -math.inf) for d in decls], dtype=float)
+        hi = np.array([_bound(d, "max", math.inf) for d in decls], dtype=float)
+        seen = dae.cache["value bounds"] = (dae.parameters, dae.inputs, lo, hi)
+    return seen[2], seen[3]
+
+
+def _check_starts(dae: Any, flat: Any) -> None:
+    """Fixed start values inside their bounds, all start values finite."""
     decls = {v.name: v for v in flat.variables} if flat is not None else {}
     for k, value in dae.fixed:
         name = dae.names[k]
@@ -246,10 +277,10 @@ def check_values(dae: Any, p: np.ndarray, flat: Any = None) -> None:
             continue
         _check_one("start value of", name, value, decl, _declared(v) if v is not None else "")
     for names, starts in ((dae.state_names, dae.x_start), (dae.algebraic_names, dae.z_start)):
-        for name, value in zip(names, np.asarray(starts, dtype=float), strict=False):
-            if not math.isfinite(value):
-                raise ParameterError(f"start value of {name} is {value}: it must be a finite "
-                                     "number")
+        starts = np.asarray(starts, dtype=float).ravel()
+        for k in np.flatnonzero(~np.isfinite(starts[:len(names)])).tolist()[:1]:
+            raise ParameterError(f"start value of {names[k]} is {starts[k]}: it must be a "
+                                 "finite number")
 
 
 def _declared(v: Any, sep: str = " (") -> str:
