@@ -137,8 +137,21 @@ _PLAIN = (str, float, int, bool, type(None), tuple)
 class _KeyWriter:
     """Text of the parts of one model: element paths and dotted symbol names resolved."""
 
-    def __init__(self, paths: dict[int, str], names: dict[int, str]) -> None:
-        self.paths, self.names = paths, names
+    def __init__(self, paths: dict[int, str]) -> None:
+        self.paths = paths
+
+    def name(self, sym: Any) -> str | None:
+        """Dotted name of a symbol of the model (``der(...)`` for a derivative), None for a
+        symbol that is not part of it."""
+        base = getattr(sym, "der_of", None)
+        if base is not None:
+            inner = self.name(base) if base.der is sym else None
+            return None if inner is None else f"der({inner})"
+        owner = getattr(sym, "owner", None)
+        path = self.paths.get(id(owner))
+        if path is None or owner._symbols.get(sym.name) is not sym:
+            return None
+        return f"{path}.{sym.name}" if path else sym.name
 
     def decl(self, decl: Any, where: str) -> str:
         """Every field of a declaration but its description, and the value of a numeric
@@ -163,7 +176,7 @@ class _KeyWriter:
         if isinstance(e, float):
             return repr(e)
         if isinstance(e, Leaf):
-            name = self.names.get(id(e.sym))
+            name = self.name(e.sym)
             if name is None:
                 name = getattr(e.sym, "name", "?")
                 if name != "time":
@@ -195,31 +208,29 @@ def _first_item(pair: tuple[str, Any]) -> str:
     return pair[0]
 
 
-def model_key(model: Component) -> str:
-    """The cache key of ``model``: a hex digest of its structure and code (see the module
-    docstring); raises :class:`Uncacheable` for models the key cannot describe."""
-    from .core.arrays import ArrayExpr, ElementArray
-
-    paths: dict[int, str] = {}
-    names: dict[int, str] = {}
+def walk(model: Component) -> list[tuple[Element, str]]:
+    """Every element of the tree with its dotted path, parents first."""
     order: list[tuple[Element, str]] = []
     stack: list[tuple[Element, str]] = [(model, "")]
-    while stack:                           # pass 1: paths of every element and symbol
+    while stack:
         elem, path = stack.pop()
-        paths[id(elem)] = path
         order.append((elem, path))
-        prefix = f"{path}." if path else ""
-        for name, sym in elem._symbols.items():
-            full = names[id(sym)] = prefix + name
-            der = sym.der
-            while der is not None:
-                full = names[id(der)] = f"der({full})"
-                der = der.der
         children = elem._children
         if children:
+            prefix = f"{path}." if path else ""
             stack.extend((child, prefix + child_name)
                          for child_name, child in reversed(children.items()))
-    writer = _KeyWriter(paths, names)
+    return order
+
+
+def model_key(model: Component, order: list[tuple[Element, str]] | None = None) -> str:
+    """The cache key of ``model``: a hex digest of its structure and code (see the module
+    docstring); raises :class:`Uncacheable` for models the key cannot describe. ``order``:
+    :func:`walk` of the model, if already made."""
+    from .core.arrays import ArrayExpr, ElementArray
+
+    order = walk(model) if order is None else order
+    writer = _KeyWriter({id(elem): path for elem, path in order})
     lines: list[str] = []
     add = lines.append
     classes: set[type] = set()
@@ -232,17 +243,18 @@ def model_key(model: Component) -> str:
         for name, sym in elem._symbols.items():
             text = decl_memo.get(id(sym.decl))
             if text is None:
-                text = decl_memo[id(sym.decl)] = writer.decl(sym.decl, path or "top")
-            add(f"D {name} {text}")
-        children = elem._children
-        plain = [(key, value) for key, value in vars(elem).items()
-                 if key[0] != "_" and key not in children and not isinstance(value, skip)]
+                text = decl_memo[id(sym.decl)] = " " + writer.decl(sym.decl, path or "top")
+            add("D " + name + text)
+        attrs = vars(elem)
+        other = attrs.keys() - elem._symbols.keys() - elem._children.keys()
+        plain = [(key, attrs[key]) for key in other
+                 if key[0] != "_" and not isinstance(attrs[key], skip)]
         for key, value in sorted(plain, key=_first_item):
             add(f"A {key}={_value_key(value, f'{path or cls.__name__}.{key}')}")
-        for item in getattr(elem, "_equations", ()):
-            lines.append("Q " + writer.item(item))
-        for item in elem.__dict__.get("_initial_equations", ()):
-            lines.append("I " + writer.item(item))
+        for item in attrs.get("_equations", ()):
+            add("Q " + writer.item(item))
+        for item in attrs.get("_initial_equations", ()):
+            add("I " + writer.item(item))
     h = hashlib.sha256()
     h.update(f"format {FORMAT}\ncode {_code_digest(classes)}\n".encode())
     h.update("\n".join(lines).encode())
@@ -319,9 +331,11 @@ def store(compiled: Any, folder: Path, key: str) -> Path | None:
     return path
 
 
-def load(folder: Path, key: str, model: Component) -> Any | None:
+def load(folder: Path, key: str, model: Component,
+         order: list[tuple[Element, str]] | None = None) -> Any | None:
     """The compiled model stored under ``key`` with ``model``'s parameter values, or None
-    (no entry, or an unreadable one, which is removed)."""
+    (no entry, or an unreadable one, which is removed). ``order``: :func:`walk` of the
+    model, if already made."""
     path = _entry(folder, key)
     if not path.is_file():
         return None
@@ -337,7 +351,7 @@ def load(folder: Path, key: str, model: Component) -> Any | None:
     except Exception:  # noqa: BLE001 -- a damaged entry is recompiled, not an error
         path.unlink(missing_ok=True)
         return None
-    values = _parameter_values(model)
+    values = _parameter_values(walk(model) if order is None else order)
     if not all(isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool)
                for v in values.values()):
         return None                      # compiling names the bad value
@@ -346,15 +360,15 @@ def load(folder: Path, key: str, model: Component) -> Any | None:
     return compiled
 
 
-def _parameter_values(model: Component) -> dict[str, Any]:
+def _parameter_values(order: list[tuple[Element, str]]) -> dict[str, Any]:
+    """Numeric parameter values by dotted name (``order``: :func:`walk` of the model)."""
     out: dict[str, Any] = {}
-    stack: list[tuple[Element, str]] = [(model, "")]
-    while stack:
-        elem, path = stack.pop()
+    for elem, path in order:
+        prefix = f"{path}." if path else ""
         for name, sym in elem._symbols.items():
-            if sym.decl.kind == KIND_PARAMETER and not isinstance(sym.decl.value, Expr):
-                out[f"{path}.{name}" if path else name] = sym.decl.value
-        stack.extend((c, f"{path}.{n}" if path else n) for n, c in elem._children.items())
+            decl = sym.decl
+            if decl.kind == KIND_PARAMETER and not isinstance(decl.value, Expr):
+                out[prefix + name] = decl.value
     return out
 
 

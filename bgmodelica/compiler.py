@@ -153,14 +153,15 @@ def _compile_cached(model: Component, units: str, cache: bool | str | Path) -> C
             f"compile() expects a Component instance, got {type(model).__name__}")
     folder = disk.default_dir() if cache is True else Path(cache)
     t0 = _time.perf_counter()
-    try:
-        with gc_paused():
-            key = disk.model_key(model) + f"-{units}"
-    except disk.Uncacheable:
-        key = None
+    with gc_paused():
+        order = disk.walk(model)
+        try:
+            key = disk.model_key(model, order) + f"-{units}"
+        except disk.Uncacheable:
+            key = None
     if key is not None:
         with gc_paused():
-            hit = disk.load(folder, key, model)
+            hit = disk.load(folder, key, model, order)
         if hit is not None:
             hit.timings = {"cache_load": _time.perf_counter() - t0}
             return hit

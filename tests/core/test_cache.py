@@ -112,3 +112,26 @@ def test_a_compiled_model_referring_to_a_component_is_not_stored(tmp_path):
     compiled.dae.hybrid = RC()            # a component where none may be
     assert disk.store(compiled, tmp_path, "k" * 64) is None
     assert not list(tmp_path.rglob("*.bgmc"))
+
+
+def test_imperative_equations_key_by_dotted_names():
+    """An imperative equation enters the key with the dotted names of its symbols (a
+    derivative as ``der(...)``); one that uses a symbol of another model is uncacheable."""
+    from bgmodelica import Component, Variable, der
+
+    class Tank(Component):
+        h = Variable(start=1.0)
+
+    def model(rate: float, other: Tank | None = None) -> Component:
+        m = Component(name="Tanks")
+        a, b = m.add("a", Tank()), m.add("b", Tank())
+        m.equation(der(a.h) == -rate * a.h, b.h == (other or a).h)
+        return m
+
+    assert disk.model_key(model(1.0)) == disk.model_key(model(1.0))
+    assert disk.model_key(model(1.0)) != disk.model_key(model(2.0))
+    with pytest.raises(disk.Uncacheable, match="not part of the model"):
+        disk.model_key(model(1.0, other=Tank()))
+    m = model(1.0)
+    writer = disk._KeyWriter({id(m): "", id(m.a): "a", id(m.b): "b"})
+    assert writer.name(m.a._symbols["h"].der) == "der(a.h)"
