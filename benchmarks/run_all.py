@@ -36,7 +36,8 @@ sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent))
 
 MARK_START, MARK_END = "<!-- perf-table:start -->", "<!-- perf-table:end -->"
-_METHOD = ("one run; ratios against baselines measured in the same run; the component "
+_METHOD = ("one run; ratios against baselines measured in the same run; the ladder's floor "
+           "returns the same two trajectories (C1.v, Cn.v) as ours; the component "
            "ladder and its floor alternate, best of two each up to n = 10,000; the CS FMU "
            "and native runs alternate, best of 10 (they take milliseconds); the master and "
            "fmucontainer alternate, best of 5")
@@ -311,6 +312,10 @@ def master_vs_container(stop_time: float, repeat: int) -> dict:
     return out
 
 
+#: the acceptance figures the array form of the ladder is held to (the ladder's, whatever form)
+_VECTOR_TARGETS = {1000: "< 0.5 s", 10000: "<= 2.5x", 100000: "compile < 1 s"}
+
+
 def table(report: dict) -> str:
     """The README's performance table (Markdown) from a report."""
     lines = ["| benchmark | bgmodelica | baseline (same run) | ratio | target |",
@@ -340,7 +345,7 @@ def table(report: dict) -> str:
         lines.append(f"| RC ladder, array equations, n = {r['n']:,}, build + 10-s solve | "
                      f"{r['total']:.3f} s (compile {r['compile']:.3f} s) | CasADi/CVODES by "
                      f"hand {r['casadi_cvodes_total']:.3f} s | {r['ratio_vs_casadi']:.2f}x | "
-                     f"{'compile < 1 s' if r['n'] == 100000 else ''} |")
+                     f"{_VECTOR_TARGETS.get(r['n'], '')} |")
     for r in report.get("cache", []):
         gain = r["compile"] / r["cached_compile"]
         said = f"{gain:.1f}x faster" if gain >= 1 else \
