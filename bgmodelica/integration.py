@@ -55,10 +55,14 @@ def _integrate(dae: CasadiDAE, solver: str, grid: np.ndarray, x0, z0, p, opts, p
         chunks = [np.concatenate(([chunks[k - 1][-1]], c)) if k else c
                   for k, c in enumerate(chunks)]
     xs, zs = [x0.reshape(nx, 1)], [np.asarray(z0).reshape(-1, 1)]
-    # one chunk (the usual run): the solver writes the states straight into the trajectory
-    # (its columns follow x0), instead of into its own buffer copied afterwards; a large
-    # model's trajectory is then held once (800 MB for 1e5 states at 1001 points)
-    whole = np.empty((len(grid), nx)) if len(chunks) == 1 and len(grid) > 1 else None
+    # one chunk (the usual run): the solver writes the states and algebraic variables
+    # straight into the trajectories (their columns follow x0, z0), instead of into its own
+    # buffers copied afterwards; a large model's trajectory is then held once (800 MB for
+    # 1e5 states at 1001 points)
+    nz = len(z0)
+    single = len(chunks) == 1 and len(grid) > 1
+    whole_x = np.empty((len(grid), nx)) if single else None
+    whole_z = np.empty((len(grid), nz)) if single and nz else None
     stats: dict[str, Any] = {}
     failure = None
     xk, zk = x0, z0
@@ -72,12 +76,12 @@ def _integrate(dae: CasadiDAE, solver: str, grid: np.ndarray, x0, z0, p, opts, p
             if solver == "idas" and dae.x.numel():
                 chunk_opts["init_xdot"] = _xdot(dae, chunk[0], xk, zk, p)
             F = _cached_integrator(dae, solver, chunk[0], chunk[1:], chunk_opts)
-            into = None
-            if whole is not None:
-                whole[0] = np.asarray(x0, dtype=float).ravel()
-                into = whole[1:].reshape(-1)
-            xf, zf, run_stats = _run_integrator(F, xk, zk, p, nx, len(z0), len(chunk) - 1,
-                                                into)
+            into = {}
+            for name, whole, first in (("xf", whole_x, x0), ("zf", whole_z, z0)):
+                if whole is not None:
+                    whole[0] = np.asarray(first, dtype=float).ravel()
+                    into[name] = whole[1:].reshape(-1)
+            xf, zf, run_stats = _run_integrator(F, xk, zk, p, nx, nz, len(chunk) - 1, into)
         except RuntimeError as err:
             failure = str(err)
             break
@@ -93,22 +97,22 @@ def _integrate(dae: CasadiDAE, solver: str, grid: np.ndarray, x0, z0, p, opts, p
         return _integrate(dae, solver, grid, x0, z0, p, opts, lambda _f: None)
     if not dae.x.numel():
         X = np.zeros((0, sum(a.shape[1] for a in xs)))
-    elif whole is not None and failure is None:
-        X = whole.T                                   # (nx, points), no copy
+    elif whole_x is not None and failure is None:
+        X = whole_x.T                                 # (nx, points), no copy
     else:
         X = np.hstack(xs)[: dae.x.numel()]
-    Z = np.hstack(zs)
+    Z = whole_z.T if whole_z is not None and failure is None else np.hstack(zs)
     return X, Z, stats, failure
 
 
 def _run_integrator(F: ca.Function, x0, z0, p, nx: int, nz: int, n_out: int,
-                    into: np.ndarray | None = None):
+                    into: dict[str, np.ndarray] | None = None):
     """``F(x0, z0, p)`` as numpy ``(xf, zf, stats)``, ``nx x n_out`` and ``nz x n_out``, through
     bound buffers (:class:`~bgmodelica.events.fast.Fast`): converting CasADi's DM results
-    costs more than integrating a large model. ``into``: a flat buffer of ``nx*n_out``
-    values the states are written to (``xf`` is then its view). A failed run is repeated
+    costs more than integrating a large model. ``into``: flat buffers the outputs ``"xf"``,
+    ``"zf"`` are written to (the results are then their views). A failed run is repeated
     through the plain call, whose exception carries the solver's message."""
-    fast = Fast(F, None if into is None else {F.index_out("xf"): into})
+    fast = Fast(F, {F.index_out(name): buf for name, buf in (into or {}).items()})
     fast.args[F.index_in("x0")][:] = np.asarray(x0, dtype=float).ravel()
     if nz:
         fast.args[F.index_in("z0")][:] = np.asarray(z0, dtype=float).ravel()
