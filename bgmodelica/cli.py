@@ -129,7 +129,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     from .compiler import compile
     from .core.arrays import compact_names
     from .loader import load_model
-    from .validate import check_values
+    from .value_checks import check_values
 
     model = load_model(args.model, **_model_kwargs(args.arg))
     compiled = compile(model, units=args.units, cache=args.cache)

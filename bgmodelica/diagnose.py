@@ -39,7 +39,7 @@ class _Point:
     """Values of every symbol of a sorted model at one point, and evaluation of expressions."""
 
     def __init__(self, dae: Any, values: dict[str, float], p: np.ndarray, t: float) -> None:
-        from .validate import _bound_values
+        from .value_checks import _bound_values
 
         srt = dae.sorted
         self.model = srt.model

@@ -20,7 +20,8 @@ from .events.fast import Fast
 from .integration import _integrate, _integrator, _xdot  # noqa: F401 (used by studies)
 from .result import Result
 from .solver_options import integrator_settings
-from .validate import check_run_options, check_values, output_grid
+from .validate import check_run_options, output_grid
+from .value_checks import check_values
 
 _HINTS = {
     "IDA_CONV_FAIL": "the Newton iteration failed repeatedly: the model may be singular at "

@@ -167,7 +167,7 @@ def operating_point(model: Any, params: dict[str, Any] | None = None, *, steady:
     from ..compiler import CompiledModel, compile
     from ..core.units import with_units
     from ..simulate import _selector, _split_overrides, _with_starts
-    from ..validate import check_values
+    from ..value_checks import check_values
 
     if steady and at_time is not None:
         raise ParameterError("choose either a steady state or a time of a simulation "
