@@ -12,6 +12,12 @@ Entries are a pickle of the :class:`~bgmodelica.compiler.CompiledModel` whose Ca
 expressions are stored together in one CasADi serialization (so the expressions keep sharing
 their symbols). ``compile(model, cache=True)`` uses :func:`default_dir` (``$BGMODELICA_CACHE``
 or ``~/.cache/bgmodelica``); ``cache="path"`` another folder; :func:`clear` empties it.
+
+An entry that does not pay is dropped: when loading it took longer than compiling the model
+had taken (and more than :data:`MIN_LOSS` seconds), it is replaced by a small note
+(``KEY.nocache``, the two times in JSON) and later compilations of that model skip the
+cache. Large models made of array equations are the usual case: they compile about as fast
+as they load.
 """
 
 from __future__ import annotations
@@ -36,6 +42,8 @@ from .core.expr import Equation, Expr, Leaf, Op
 from .core.variables import KIND_PARAMETER
 
 FORMAT = 1
+#: a load slower than compiling is ignored below this many seconds [s] (noise, small models)
+MIN_LOSS = 0.5
 _FILE_DIGESTS: dict[tuple[str, int, int], str] = {}
 
 
@@ -60,6 +68,8 @@ def clear(folder: str | Path | None = None) -> int:
     for entry in root.glob("*/*.bgmc"):
         entry.unlink()
         n += 1
+    for note in root.glob("*/*.nocache"):
+        note.unlink()
     return n
 
 
@@ -305,6 +315,31 @@ def _stored_sx(index: int) -> ca.SX:
 
 def _entry(folder: Path, key: str) -> Path:
     return folder / key[:2] / f"{key}.bgmc"
+
+
+def _note(folder: Path, key: str) -> Path:
+    return folder / key[:2] / f"{key}.nocache"
+
+
+def pays(compile_seconds: float, load_seconds: float) -> bool:
+    """Whether an entry that loaded in ``load_seconds`` is worth keeping for a model that
+    compiled in ``compile_seconds``."""
+    return load_seconds <= max(compile_seconds, MIN_LOSS)
+
+
+def skipped(folder: Path, key: str) -> bool:
+    """Whether an earlier load found that the entry of ``key`` does not pay."""
+    return _note(folder, key).is_file()
+
+
+def drop(folder: Path, key: str, compile_seconds: float, load_seconds: float) -> None:
+    """Replace the entry of ``key`` by a note that it does not pay (see the module docs)."""
+    import json
+
+    note = _note(folder, key)
+    note.parent.mkdir(parents=True, exist_ok=True)
+    note.write_text(json.dumps({"compile_s": compile_seconds, "load_s": load_seconds}))
+    _entry(folder, key).unlink(missing_ok=True)
 
 
 def store(compiled: Any, folder: Path, key: str) -> Path | None:

@@ -135,7 +135,9 @@ def compile(model: Component, *, select: Selector | None = None,  # noqa: A001
     cache: keep the compiled model on disk and load it the next time the same model (same
     structure and code; parameter values may differ) is compiled: True uses
     :func:`bgmodelica.cache.default_dir`, a path another folder (see :mod:`bgmodelica.cache`).
-    ``timings`` then holds ``cache_load`` (a hit) or the stages and ``cache_store``.
+    ``timings`` then holds ``cache_load`` (a hit) or the stages and ``cache_store``, or the
+    stages and ``cache_skipped`` (the seconds spent making the key) for a model whose entry
+    was dropped because loading it cost more than compiling (see :mod:`bgmodelica.cache`).
 
     The cyclic garbage collector is paused meanwhile: compilation allocates millions of
     objects that live until the end, and rescanning them costs more than it frees."""
@@ -159,15 +161,22 @@ def _compile_cached(model: Component, units: str, cache: bool | str | Path) -> C
             key = disk.model_key(model, order) + f"-{units}"
         except disk.Uncacheable:
             key = None
-    if key is not None:
+    skip = key is not None and disk.skipped(folder, key)
+    if key is not None and not skip:
         with gc_paused():
             hit = disk.load(folder, key, model, order)
         if hit is not None:
+            built = sum(v for k, v in hit.timings.items() if k != "cache_store")
             hit.timings = {"cache_load": _time.perf_counter() - t0}
+            if not disk.pays(built, hit.timings["cache_load"]):
+                disk.drop(folder, key, built, hit.timings["cache_load"])
             return hit
+    t1 = _time.perf_counter()
     with gc_paused():
         compiled = _compile(model, None, units)
-    if key is not None:
+    if skip:
+        compiled.timings["cache_skipped"] = t1 - t0
+    elif key is not None:
         t1 = _time.perf_counter()
         with gc_paused():
             disk.store(compiled, folder, key)

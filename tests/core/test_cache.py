@@ -4,6 +4,7 @@ values taken from the model asked for, damaged entries, the command line."""
 from __future__ import annotations
 
 import importlib
+import json
 import os
 import subprocess
 import sys
@@ -135,3 +136,37 @@ def test_imperative_equations_key_by_dotted_names():
     m = model(1.0)
     writer = disk._KeyWriter({id(m): "", id(m.a): "a", id(m.b): "b"})
     assert writer.name(m.a._symbols["h"].der) == "der(a.h)"
+
+
+def test_an_entry_that_loads_slower_than_compiling_is_dropped(tmp_path, monkeypatch):
+    first = bg.compile(RCLadderVector(30), cache=tmp_path)
+    built = sum(v for k, v in first.timings.items() if k != "cache_store")
+    seen = []
+
+    def slow(compile_seconds, load_seconds):          # as if loading had cost more
+        seen.append((compile_seconds, load_seconds))
+        return False
+
+    monkeypatch.setattr(disk, "pays", slow)
+    hit = bg.compile(RCLadderVector(30), cache=tmp_path)     # this load still counts
+    assert set(hit.timings) == {"cache_load"}
+    assert seen == [(pytest.approx(built, rel=1e-12), hit.timings["cache_load"])]
+    assert not entries(tmp_path)
+    (note,) = tmp_path.glob("*/*.nocache")
+    assert set(json.loads(note.read_text())) == {"compile_s", "load_s"}
+    monkeypatch.undo()
+    third = bg.compile(RCLadderVector(30), cache=tmp_path)   # compiled, nothing stored
+    assert "cache_skipped" in third.timings and "flatten" in third.timings
+    assert "cache_store" not in third.timings and not entries(tmp_path)
+    a = bg.simulate(first, stop_time=0.5, interval=0.05)
+    b = bg.simulate(third, stop_time=0.5, interval=0.05)
+    assert all(np.array_equal(a[n], b[n]) for n in a.names)
+    disk.clear(tmp_path)                                     # the note goes too
+    assert not list(tmp_path.glob("*/*.nocache"))
+    assert "cache_store" in bg.compile(RCLadderVector(30), cache=tmp_path).timings
+
+
+def test_only_a_clear_loss_drops_an_entry():
+    assert disk.pays(1.0, 0.9) and disk.pays(1.0, 1.0) and not disk.pays(1.0, 1.2)
+    assert disk.pays(0.01, disk.MIN_LOSS)        # small models: noise, not a loss
+    assert not disk.pays(0.01, disk.MIN_LOSS + 0.01)
