@@ -1,6 +1,7 @@
 """Long sums (a ground node joined to every section) are kept out of the whole-model
-sparsity pass: same incidence, same compiled model, and the flag survives the passes. Also
-the coloring that batches the explicit scalar solutions."""
+sparsity pass: same incidence, same compiled model, and the flag survives the passes. Dense
+columns of large patterns get a pass of their own, with the same incidence. Also the
+coloring that batches the explicit scalar solutions."""
 
 from __future__ import annotations
 
@@ -24,6 +25,29 @@ def test_incidence_with_long_rows_equals_the_plain_pass():
     plain = incidence(rows, xs)
     assert incidence(rows, xs, {17}) == plain
     assert plain[17][:3] == [0, 2, 3] and len(plain[17]) == 251
+
+
+def test_dense_columns_get_their_own_pass_with_the_same_incidence(monkeypatch):
+    import bgmodelica.passes.symbolic as symbolic
+
+    n = 3000
+    x = ca.SX.sym("x", n + 2)
+    g, h, xx = x[n], x[n + 1], x[:n]
+    every_third = ca.DM([1.0 if k % 3 == 0 else 0.0 for k in range(n - 2)])
+    r = ca.vertcat(xx[0] * h, xx[:-2] - 2 * xx[1:-1] + ca.sin(xx[2:]) + g * every_third,
+                   xx[-1] * g)
+    plain = symbolic._sparsity_rows(r, x)                  # below the size: one pass
+    assert plain[1] == [0, 1, 2, n] and plain[2] == [1, 2, 3] and plain[0] == [0, n + 1]
+    monkeypatch.setattr(symbolic, "DENSE_CHECK_SIZE", 100)
+    assert list(symbolic._dense_columns(r, x)) == [n]      # g: a third of the rows
+    split = symbolic._sparsity_rows(r, x)
+    assert split == plain and all(type(c) is int for row in split for c in row)
+    monkeypatch.setattr(symbolic, "DENSE_SAMPLE", 50)      # few samples: more "dense"
+    assert symbolic._sparsity_rows(r, x) == plain
+    compiled = bg.compile(RCLadder(40))                      # the compiler on the split
+    monkeypatch.setattr(symbolic, "DENSE_CHECK_SIZE", 2**17)
+    ref = bg.compile(RCLadder(40))
+    assert str(compiled.dae.ode) == str(ref.dae.ode)
 
 
 def test_ground_balance_is_marked_long_and_compiles_as_without_the_split(monkeypatch):
