@@ -69,9 +69,6 @@ def main(repeat: int = 5) -> dict:
             "core", s, {"x": dae.x, "p": dae.p, "t": dae.t, "ode": dae.ode}, 0.0,
             list(grid[1:]), {"abstol": ATOL, "reltol": RTOL})(x0=init.x0, p=dae.p_vector()),
             repeat)[0]
-    sim_dynamic, res_dyn = best_of(lambda: simulate(compiled, stop_time=STOP, interval=DT,
-                                                    rtol=RTOL, atol=ATOL, solver="auto"),
-                                   repeat)
     res = sims["idas"][1]
 
     # 2. hand-written CasADi ODE + CVODES -------------------------------------------------------
@@ -84,7 +81,16 @@ def main(repeat: int = 5) -> dict:
                           list(grid[1:]), {"abstol": ATOL, "reltol": RTOL})
         return F, np.asarray(F(x0=np.zeros(N_STATES))["xf"])
 
-    t_casadi, (F, xs) = best_of(casadi_run, repeat)
+    def auto_run():
+        return simulate(compiled, stop_time=STOP, interval=DT, rtol=RTOL, atol=ATOL,
+                        solver="auto")
+
+    # the headline ratio: the two alternate, so that a noisy spell hits both
+    sim_dynamic = t_casadi = float("inf")
+    for _ in range(repeat):
+        t_auto, res_dyn = best_of(auto_run, 1)
+        t_hand, (F, xs) = best_of(casadi_run, 1)
+        sim_dynamic, t_casadi = min(sim_dynamic, t_auto), min(t_casadi, t_hand)
     casadi_steps = int(F.stats()["nsteps"])
 
     # 3. scipy BDF, numpy right-hand side -----------------------------------------------------
