@@ -1,0 +1,25 @@
+"""Which observed outputs can turn non-finite for finite inputs (the result check evaluates
+only those): a division by, or a root, logarithm or power of, something that varies."""
+
+from __future__ import annotations
+
+import casadi as ca
+
+from bgmodelica.diagnose import unsafe_outputs
+
+
+def test_unsafe_outputs_by_operation_and_by_what_varies():
+    x, p = ca.SX.sym("x", 4), ca.SX.sym("p")
+    outs = [x[0] / x[1],            # 0: division by a varying input
+            1 / p,                  # 1: by a constant input only
+            ca.sqrt(x[2] * p),      # 2: root of something varying
+            ca.log(p),              # 3: of a constant input
+            x[0] ** x[1],           # 4: power
+            ca.sin(x[3]) / 2,       # 5: division by a number
+            x[0] * p + 3,           # 6: polynomial
+            ca.exp(1 / x[2]) - x[3],  # 7: a division deep inside
+            ca.DM(2.0)]             # 8: a constant
+    f = ca.Function("f", [x, p], [ca.vertcat(*outs)])
+    assert unsafe_outputs(f, (0,)) == [0, 2, 4, 7]
+    assert unsafe_outputs(f, (0, 1)) == [0, 1, 2, 3, 4, 7]     # p varies too
+    assert unsafe_outputs(f, ()) == []
