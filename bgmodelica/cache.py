@@ -13,11 +13,11 @@ expressions are stored together in one CasADi serialization (so the expressions 
 their symbols). ``compile(model, cache=True)`` uses :func:`default_dir` (``$BGMODELICA_CACHE``
 or ``~/.cache/bgmodelica``); ``cache="path"`` another folder; :func:`clear` empties it.
 
-An entry that does not pay is dropped: when loading it took longer than compiling the model
-had taken (and more than :data:`MIN_LOSS` seconds), it is replaced by a small note
-(``KEY.nocache``, the two times in JSON) and later compilations of that model skip the
-cache. Large models made of array equations are the usual case: they compile about as fast
-as they load.
+An entry that does not pay is dropped: when loading it (its key included) took longer than
+compiling the model had taken (and more than :data:`MIN_LOSS` seconds), it is replaced by a
+small note (``KEY.nocache``, the two times in JSON) and later compilations of that model
+skip the cache. Large models made of array equations are the usual case: they compile
+about as fast as they load.
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ import copyreg
 import functools
 import hashlib
 import io
+import json
 import os
 import pickle
 import sys
@@ -334,8 +335,6 @@ def skipped(folder: Path, key: str) -> bool:
 
 def drop(folder: Path, key: str, compile_seconds: float, load_seconds: float) -> None:
     """Replace the entry of ``key`` by a note that it does not pay (see the module docs)."""
-    import json
-
     note = _note(folder, key)
     note.parent.mkdir(parents=True, exist_ok=True)
     note.write_text(json.dumps({"compile_s": compile_seconds, "load_s": load_seconds}))

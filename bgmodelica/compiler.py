@@ -171,11 +171,11 @@ def _compile_cached(model: Component, units: str, cache: bool | str | Path) -> C
             if not disk.pays(built, hit.timings["cache_load"]):
                 disk.drop(folder, key, built, hit.timings["cache_load"])
             return hit
-    t1 = _time.perf_counter()
+    keyed = _time.perf_counter()
     with gc_paused():
         compiled = _compile(model, None, units)
     if skip:
-        compiled.timings["cache_skipped"] = t1 - t0
+        compiled.timings["cache_skipped"] = keyed - t0
     elif key is not None:
         t1 = _time.perf_counter()
         with gc_paused():
