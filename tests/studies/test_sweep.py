@@ -12,8 +12,8 @@ import bgmodelica as bg
 from bgmodelica.cli import main
 from bgmodelica.errors import ModelError, OptionError, ParameterError
 from bgmodelica.studies import sweep
+from bgmodelica.studies.design import parse_distribution, parse_grid
 from bgmodelica.studies.payload import _CACHE, STATS, payload_for
-from bgmodelica.studies.sweeps import parse_distribution, parse_grid
 
 xr = pytest.importorskip("xarray")
 
