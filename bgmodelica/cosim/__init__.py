@@ -5,8 +5,8 @@ Modules:
 
 - :mod:`.wrap`: :func:`expose` turns an acausal component into a causal subsystem (connectors
   driven by / returning top-level inputs and outputs) for FMU export;
-- :mod:`.ssp`: SSP 1.0 archives -- :func:`write_ssp`, :func:`read_ssp`,
-  :func:`system_from_fmus`, :class:`SystemStructure`;
+- :mod:`.ssp`: SSP 1.0 set-ups -- :class:`SystemStructure`, :func:`system_from_fmus`,
+  :func:`write_ssp`; :mod:`.ssp_read`: :func:`read_ssp` (defensive reading of archives);
 - :mod:`.fmu`: FMU model descriptions and fmpy-based Co-Simulation / Model Exchange units;
 - :mod:`.archive`: safe reading and extraction of FMU/SSP zip archives (:class:`SafeZip`);
 - :mod:`.checks`: set-up checks (unconnected inputs, type/unit mismatches, algebraic loops);
@@ -44,10 +44,10 @@ from .ssp import (
     SspConnection,
     SspConnector,
     SystemStructure,
-    read_ssp,
     system_from_fmus,
     write_ssp,
 )
+from .ssp_read import read_ssp
 from .verify import VerificationReport, verify_model
 from .wrap import FlowInput, FlowOutput, PotentialInput, PotentialOutput, add_signal, expose
 

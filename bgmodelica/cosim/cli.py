@@ -85,7 +85,7 @@ def _write_atomically(path: Path, write: Callable[[Path], Any], what: str) -> No
 def cmd_cosim(args: argparse.Namespace) -> int:
     """``bgmodelica cosim``: run an SSP set-up, write the CSV (and a plot)."""
     from .master import Master
-    from .ssp import read_ssp
+    from .ssp_read import read_ssp
 
     for value, what in ((args.stop_time, "--stop-time"), (args.step, "--step")):
         if value is not None and not (math.isfinite(value) and value > 0):
@@ -173,7 +173,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
     """``bgmodelica verify MODEL SSP``: monolithic model vs co-simulation of its parts;
     exit status 1 when ``--tolerance`` is exceeded."""
     from ..loader import load_model
-    from .ssp import read_ssp
+    from .ssp_read import read_ssp
     from .verify import SCHEMES, verify_model
 
     def progress(msg: str) -> None:

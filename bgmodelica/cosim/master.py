@@ -70,7 +70,8 @@ from .errors import (
 )
 from .fmu import FmuInfo, read_fmu_info
 from .signals import input_signals
-from .ssp import SystemStructure, read_ssp
+from .ssp import SystemStructure
+from .ssp_read import read_ssp
 from .units import make_unit
 
 ORDERS = ("jacobi", "gauss-seidel")

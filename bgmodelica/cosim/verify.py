@@ -367,7 +367,7 @@ def verify_model(model: Any, system: Any, steps: Sequence[float] | None = None,
     """
     from bgmodelica import CompiledModel, compile, simulate
 
-    from .ssp import read_ssp
+    from .ssp_read import read_ssp
 
     say = progress or (lambda _msg: None)
     if isinstance(system, (str, Path)):

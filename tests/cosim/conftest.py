@@ -43,7 +43,7 @@ def robot_fmus(robot_setup):
 
 @pytest.fixture(scope="session")
 def robot_ssp(robot_setup):
-    from bgmodelica.cosim.ssp import read_ssp
+    from bgmodelica.cosim.ssp_read import read_ssp
 
     return read_ssp(robot_setup["ssp"])
 

@@ -23,7 +23,8 @@ from bgmodelica.cosim.errors import (
 )
 from bgmodelica.cosim.fmu import read_fmu_info
 from bgmodelica.cosim.master import Master
-from bgmodelica.cosim.ssp import read_ssp, ssd_xml, write_ssp
+from bgmodelica.cosim.ssp import ssd_xml, write_ssp
+from bgmodelica.cosim.ssp_read import read_ssp
 from bgmodelica.errors import ModelError
 
 MD = b'<?xml version="1.0"?><fmiModelDescription fmiVersion="2.0"/>'
@@ -355,7 +356,7 @@ def test_unsafe_reason_and_normalize():
 
 def test_bytes_io_parse_unchanged():
     """parse_ssd still accepts a plain ZipFile (the SSD tests use one)."""
-    from bgmodelica.cosim.ssp import parse_ssd
+    from bgmodelica.cosim.ssp_read import parse_ssd
 
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w"):

@@ -30,10 +30,10 @@ from bgmodelica.cosim.master import Master, count_steps
 from bgmodelica.cosim.ssp import (
     SspConnection,
     SspConnector,
-    read_ssp,
     system_from_fmus,
     write_ssp,
 )
+from bgmodelica.cosim.ssp_read import read_ssp
 from bgmodelica.errors import ModelError, ParameterError
 
 

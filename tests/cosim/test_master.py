@@ -12,7 +12,7 @@ from cosim_helpers import HORIZON, joint_errors, tight
 from bgmodelica import compile, simulate
 from bgmodelica.cosim.errors import CosimStepError
 from bgmodelica.cosim.master import Master, cosimulate
-from bgmodelica.cosim.ssp import read_ssp
+from bgmodelica.cosim.ssp_read import read_ssp
 from library.robots.robot import RobotPID
 from library.robots.subsystems import build_robot_fmus, robot_system
 

@@ -7,13 +7,8 @@ import zipfile
 import pytest
 
 from bgmodelica.cosim.errors import SspFormatError
-from bgmodelica.cosim.ssp import (
-    SspConnection,
-    parse_ssd,
-    read_ssp,
-    ssd_xml,
-    write_ssp,
-)
+from bgmodelica.cosim.ssp import SspConnection, ssd_xml, write_ssp
+from bgmodelica.cosim.ssp_read import parse_ssd, read_ssp
 from library.robots.subsystems import robot_connections, robot_parameters
 
 

@@ -179,7 +179,8 @@ def test_fmi2_types_through_a_chain(c_fmus, interface):
 def test_typed_values_in_an_ssp(c_fmus, tmp_path):
     """SSP round trip: Integer, Boolean and String bindings keep their types; typed
     connections run from the file."""
-    from bgmodelica.cosim.ssp import read_ssp, write_ssp
+    from bgmodelica.cosim.ssp import write_ssp
+    from bgmodelica.cosim.ssp_read import read_ssp
 
     path = c_fmus["Feedthrough"]
     system = system_from_fmus(
