@@ -16,7 +16,6 @@ from .causality import (
     IdealMode,
     assign_causality,
     ideal_modes,
-    signal_graph,
 )
 from .draw import draw, layout
 from .elements import (
@@ -53,6 +52,7 @@ from .errors import (
 from .graph import Bond, Graph, Node
 from .model import BondGraph, graph_of
 from .report import BondGraphReport, analyze
+from .signal_flow import signal_graph
 from .structural import StructuralProperty, controllability, observability
 
 __all__ = [

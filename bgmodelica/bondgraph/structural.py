@@ -17,9 +17,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from .causality import BGD, Causality, assign_causality, path_to, reach, signal_graph
+from .causality import BGD, Causality, assign_causality
 from .errors import BondError
 from .graph import Graph
+from .signal_flow import path_to, reach, signal_graph
 
 
 @dataclass
