@@ -10,7 +10,8 @@ runs, not with this package.
 
 from __future__ import annotations
 
-from .fitting import Experiment, FitResult, IdentifiabilityError, fit
+from .fitting import Experiment, FitResult, fit
+from .identifiability import IdentifiabilityError
 from .sensitivity import finite_difference_sensitivities, sensitivities
 from .sweeps import SweepResult, sweep
 

@@ -23,116 +23,18 @@ of parameters that leaves the outputs unchanged.
 
 from __future__ import annotations
 
-import csv
 import math
 import time as _time
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..errors import ModelError, OptionError, SimulationError
-
-
-class IdentifiabilityError(ModelError):
-    """The free parameters cannot be determined from the data (rank-deficient sensitivity
-    matrix): ``rank``, ``singular_values`` and the unidentifiable ``direction``."""
-
-    def __init__(self, message: str, rank: int = 0, singular_values: Any = None,
-                 direction: dict[str, float] | None = None) -> None:
-        super().__init__(message)
-        self.rank = rank
-        self.singular_values = singular_values
-        self.direction = direction or {}
-
-
-class FitError(ModelError):
-    """The data or the fit set-up is unusable, or the model failed during the fit."""
-
-
-@dataclass
-class Experiment:
-    """One measured run: ``data`` (CSV path, pandas DataFrame, mapping of columns with
-    ``"time"``, or a :class:`~bgmodelica.result.Result` with ``columns``), the parameter
-    values of this experiment (``params``), column weights (1/sigma) and a name."""
-
-    data: Any
-    params: dict[str, Any] = field(default_factory=dict)
-    weights: dict[str, float] | None = None
-    name: str = ""
-    columns: Sequence[str] | None = None
-    start_time: float | None = None       # default: fit(start_time=...)
-
-
-def load_table(data: Any, columns: Sequence[str] | None = None,
-               what: str = "data") -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """``(times, {column: values})`` from a CSV file (first column the time), a DataFrame,
-    a mapping or a Result."""
-    from ..result import Result
-
-    if isinstance(data, (str, Path)):
-        path = Path(data)
-        if not path.is_file():
-            raise FitError(f"{what}: no such file {path}")
-        with path.open(newline="") as fh:
-            rows = list(csv.reader(fh))
-        rows = [r for r in rows if r and any(c.strip() for c in r)]
-        if len(rows) < 2:
-            raise FitError(f"{path}: needs a header row and at least one data row")
-        header = [h.strip() for h in rows[0]]
-        try:
-            values = np.array([[float(c) if c.strip() else np.nan for c in r] + [np.nan] * (
-                len(header) - len(r)) for r in rows[1:]], dtype=float)
-        except ValueError as err:
-            raise FitError(f"{path}: not a table of numbers ({err})") from None
-        if values.shape[1] != len(header):
-            raise FitError(f"{path}: rows longer than the header")
-        table = {h: values[:, k] for k, h in enumerate(header)}
-        tname = header[0]
-        if tname.lower() not in ("time", "t", "time [s]"):
-            raise FitError(f"{path}: the first column must be 'time', found {tname!r}")
-        times = table.pop(tname)
-        what = str(path)
-    elif isinstance(data, Result):
-        if not columns:
-            raise FitError(f"{what}: a Result needs the columns to fit (columns=[...])")
-        times = np.asarray(data.time, dtype=float)
-        table = {c: np.asarray(data[c], dtype=float) for c in columns}
-    elif hasattr(data, "columns") and hasattr(data, "to_numpy"):        # a DataFrame
-        cols = {str(c): np.asarray(data[c].to_numpy(), dtype=float) for c in data.columns}
-        tkey = next((k for k in cols if k.lower() in ("time", "t")), None)
-        times = cols.pop(tkey) if tkey else np.asarray(data.index.to_numpy(), dtype=float)
-        table = cols
-    elif isinstance(data, Mapping):
-        cols = {str(k): np.asarray(v, dtype=float).ravel() for k, v in data.items()}
-        tkey = next((k for k in cols if k.lower() in ("time", "t")), None)
-        if tkey is None:
-            raise FitError(f"{what}: no 'time' column")
-        times = cols.pop(tkey)
-        table = cols
-    else:
-        raise FitError(f"{what}: expected a CSV path, a DataFrame, a mapping or a Result, got "
-                       f"{type(data).__name__}")
-    if columns is not None:
-        missing = [c for c in columns if c not in table]
-        if missing:
-            raise FitError(f"{what}: no column {missing[0]!r}; columns: {', '.join(table)}")
-        table = {c: table[c] for c in columns}
-    if not table:
-        raise FitError(f"{what}: no measured column besides the time")
-    times = np.asarray(times, dtype=float)
-    if times.ndim != 1 or not len(times) or not np.all(np.isfinite(times)):
-        raise FitError(f"{what}: the time column must be finite numbers")
-    if np.any(np.diff(times) <= 0):
-        raise FitError(f"{what}: the times must be strictly increasing")
-    for c, v in table.items():
-        if len(v) != len(times):
-            raise FitError(f"{what}: column {c!r} has {len(v)} values for {len(times)} times")
-        if np.any(np.isinf(v)):
-            raise FitError(f"{what}: column {c!r} has infinite values")
-    return times, table
+from ..errors import OptionError, SimulationError
+from .identifiability import check_identifiable
+from .measured import Experiment, FitError, as_experiments, load_table
 
 
 @dataclass
@@ -330,7 +232,7 @@ def fit(model: Any, data: Any, free: Any, *, params: Mapping[str, Any] | None = 
     use_fd = jacobian == "fd" or (jacobian == "auto" and not smooth)
     if rank_tol is None:
         rank_tol = 1e-4 if use_fd else 1e-6
-    experiments = _experiments(data)
+    experiments = as_experiments(data)
     pnames = [q.name for q in dae.parameters] + [u.name for u in dae.inputs]
     p_default = dae.p_vector(_p_only(dae, dict(params or {}), compiled))
     defaults = dict(zip(pnames, p_default[:len(pnames)], strict=True))   # not discretes
@@ -370,14 +272,14 @@ def fit(model: Any, data: Any, free: Any, *, params: Mapping[str, Any] | None = 
 
     theta0 = x0 / scale
     r0, J0 = evaluate(theta0)
-    _check_identifiable(J0 / scale, free_names, rank_tol, "at the initial values")
+    check_identifiable(J0 / scale, free_names, rank_tol, "at the initial values")
     sol = least_squares(lambda th: evaluate(th)[0], theta0, jac=lambda th: evaluate(th)[1],
                         bounds=(lo / scale, hi / scale), method="trf", x_scale=1.0,
                         ftol=ftol, xtol=xtol, gtol=gtol, max_nfev=max_nfev)
     r, Jt = evaluate(sol.x)
     est = sol.x * scale
     J = Jt / scale                                            # d r / d p (physical units)
-    sv = _check_identifiable(J, free_names, rank_tol, "at the estimates")
+    sv = check_identifiable(J, free_names, rank_tol, "at the estimates")
     dof = n_data - n_par
     s2 = float(r @ r) / dof
     U, S, Vt = np.linalg.svd(J, full_matrices=False)
@@ -402,16 +304,6 @@ def fit(model: Any, data: Any, free: Any, *, params: Mapping[str, Any] | None = 
         singular_values=[float(v) for v in sv], condition=float(sv[0] / sv[-1])
         if sv[-1] > 0 else float("inf"), seconds=_time.perf_counter() - t_begin,
         units=units_of, experiments=exps)
-
-
-def _experiments(data: Any) -> list[Experiment]:
-    if isinstance(data, Experiment):
-        return [data]
-    if isinstance(data, (list, tuple)):
-        if not data:
-            raise FitError("fit: no data")
-        return [d if isinstance(d, Experiment) else Experiment(d) for d in data]
-    return [Experiment(data)]
 
 
 def _p_only(dae: Any, params: dict[str, Any], compiled: Any) -> dict[str, Any]:
@@ -530,38 +422,6 @@ def _residuals(compiled, e: _Prepared, wrt, free, values, rtol, atol, max_step, 
         vals = ", ".join(f"{n} = {v:.6g}" for n, v in zip(free, values, strict=True))
         raise FitError(f"{e.name}: the model gives non-finite values at {vals}")
     return r, np.vstack(js)
-
-
-def _check_identifiable(J: np.ndarray, names: list[str], tol: float, where: str) -> np.ndarray:
-    """Singular values of the column-normalized Jacobian; IdentifiabilityError if its rank is
-    below the number of free parameters."""
-    norms = np.linalg.norm(J, axis=0)
-    dead = [n for n, v in zip(names, norms, strict=True) if not v > 0]
-    if dead:
-        raise IdentifiabilityError(
-            f"not identifiable {where}: the data do not depend on {', '.join(dead)} (zero "
-            "sensitivity of every fitted column); fix it or measure something it affects",
-            rank=len(names) - len(dead), direction={d: 1.0 for d in dead})
-    Jn = J / norms
-    _U, S, Vt = np.linalg.svd(Jn, full_matrices=False)
-    rank = int(np.sum(S > tol * S[0]))
-    if rank < len(names):
-        v = Vt[-1]
-        v = v / np.max(np.abs(v))
-        parts = sorted(((n, float(c)) for n, c in zip(names, v, strict=True)
-                        if abs(c) > 0.05), key=lambda x: -abs(x[1]))
-        if parts and parts[0][1] < 0:
-            parts = [(n, -c) for n, c in parts]
-        combo = " ".join(f"{'+' if c >= 0 else '-'} {abs(c):.3g}*{n}" for n, c in parts)
-        raise IdentifiabilityError(
-            f"not identifiable {where}: the sensitivity matrix of {len(names)} free parameters "
-            f"has rank {rank} (relative singular values "
-            + ", ".join(f"{s / S[0]:.2g}" for s in S)
-            + f"; tolerance {tol:g}). Changing the parameters along ({combo.lstrip('+ ')}) "
-            "(relative to their scale) leaves the data unchanged: fix one of "
-            + ", ".join(n for n, _ in parts) + " or add measurements that separate them",
-            rank=rank, singular_values=S.tolist(), direction=dict(parts))
-    return S
 
 
 def _report_experiment(compiled, e: _Prepared, wrt, est, rtol, atol, max_step) -> dict:
