@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from .causality import Causality
-from .graph import JUNCTIONS, SWITCHES, Graph
+from .graph import JUNCTIONS, SWITCHES, Graph, strong_bond
 
 
 # -- a tiny expression tree, printable as text or LaTeX -----------------------------------
@@ -285,13 +285,9 @@ def causal_equations(c: Causality) -> CausalEquations:
         if n.modulus:
             out.moduli[n.symbol] = n.modulus
         if n.kind in JUNCTIONS:
-            if n.kind == "0":
-                strong = [b for b in bonds if eto[b.number] == name]
-            else:
-                strong = [b for b in bonds if eto[b.number] != name]
-            if len(strong) != 1:
+            s = strong_bond(n, bonds, eto)
+            if s is None:
                 continue
-            s = strong[0]
             others = [b for b in bonds if b is not s]
             common, summed = ("e", "f") if n.kind == "0" else ("f", "e")
             for b in others:

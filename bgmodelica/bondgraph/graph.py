@@ -159,3 +159,14 @@ class Graph:
                         f"{node.title} element {name}: both bonds point {way} it; a "
                         "transformer or gyrator passes power through, one bond in and one "
                         "out", name)
+
+
+def strong_bond(node: Node, bonds: list[Bond], effort_to: dict[int, str]) -> Bond | None:
+    """The one bond that sets a causal junction's common variable: the bond bringing the
+    effort into a 0-junction, or the flow into a 1-junction (``effort_to``: bond number ->
+    the node its effort goes to); None unless exactly one does."""
+    if node.kind == "0":
+        strong = [b for b in bonds if effort_to[b.number] == node.name]
+    else:
+        strong = [b for b in bonds if effort_to[b.number] != node.name]
+    return strong[0] if len(strong) == 1 else None

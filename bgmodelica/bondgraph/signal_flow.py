@@ -9,7 +9,7 @@ from collections import deque
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from .graph import JUNCTIONS, STORAGE, SWITCHES, TWO_PORTS
+from .graph import JUNCTIONS, STORAGE, SWITCHES, TWO_PORTS, strong_bond
 
 if TYPE_CHECKING:
     from .causality import Causality
@@ -44,13 +44,10 @@ def signal_graph(c: Causality) -> SignalGraph:
         bonds = [b for b in inc[n.name] if b.number in eto]
         name = n.name
         if n.kind in JUNCTIONS:
-            if n.kind == "0":
-                strong = [b for b in bonds if eto[b.number] == name]
-            else:
-                strong = [b for b in bonds if eto[b.number] != name]
-            if len(strong) != 1:
+            strong = strong_bond(n, bonds, eto)
+            if strong is None:
                 continue
-            s = strong[0].number
+            s = strong.number
             for b in bonds:
                 if b.number == s:
                     continue
