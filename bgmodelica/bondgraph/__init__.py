@@ -36,7 +36,6 @@ from .elements import (
     R,
     Se,
     Sf,
-    Sw,
     ZeroJunction,
     bond_flow,
     orientation,
@@ -54,6 +53,7 @@ from .model import BondGraph, graph_of
 from .report import BondGraphReport, analyze
 from .signal_flow import signal_graph
 from .structural import StructuralProperty, controllability, observability
+from .switch import Sw
 
 __all__ = [
     "PowerPort", "BGElement", "Se", "Sf", "R", "C", "I", "TF", "GY", "MTF", "MGY",
