@@ -125,7 +125,7 @@ class Sw(BGElement):
             value = self.mode()
         except ModulusError:
             return _mode_repr(m)
-        text = _expr_text(value, _paths(self))
+        text = _to_text(value, _dotted(_paths(self)))
         if text.startswith("(") and text.endswith(")"):
             text = text[1:-1]
         return text
@@ -159,28 +159,12 @@ def _paths(elem: Any) -> dict[int, str]:
     return out
 
 
-_INFIX = {"+": " + ", "-": " - ", "*": "*", "/": "/", "**": "^", "<": " < ", "<=": " <= ",
-          "!=": " <> ", "==": " == ", "and": " and ", "or": " or "}
-
-
-def _expr_text(e: Any, paths: dict[int, str]) -> str:
-    """Like :func:`bgmodelica.core.expr.to_text`, with variables named by their dotted path
-    in the bond graph (``pwm.on`` rather than ``on``)."""
-    from ..core.expr import Leaf, Op
-
-    if isinstance(e, Leaf):
-        sym = e.sym
+def _dotted(paths: dict[int, str]) -> Any:
+    """Names of symbols by their dotted path in the bond graph (``pwm.on`` rather than
+    ``on``), for :func:`~bgmodelica.core.expr.to_text`."""
+    def name(sym: Any) -> str:
         owner = getattr(sym, "owner", None)
         path = paths.get(id(owner)) if owner is not None else None
-        name = getattr(sym, "name", "time")
-        return f"{path}.{name}" if path else name
-    if isinstance(e, Op):
-        args = [_expr_text(a, paths) for a in e.args]
-        if e.op in _INFIX:
-            return f"({args[0]}{_INFIX[e.op]}{args[1]})"
-        if e.op == "neg":
-            return f"-{args[0]}"
-        if e.op == "not":
-            return f"not {args[0]}"
-        return f"{e.op}({', '.join(args)})"
-    return _to_text(e)
+        local = getattr(sym, "name", "time")
+        return f"{path}.{local}" if path else local
+    return name

@@ -375,18 +375,20 @@ _INFIX = {"+": " + ", "-": " - ", "*": "*", "/": "/", "**": "^", "<": " < ", "<=
           "!=": " <> ", "==": " == ", "and": " and ", "or": " or "}
 
 
-def to_text(e: Any) -> str:
-    """Readable text of an expression (local names)."""
+def to_text(e: Any, name: Callable[[Any], str] | None = None) -> str:
+    """Readable text of an expression; ``name(symbol)`` names the variables (default: their
+    local names)."""
     if isinstance(e, float):
         return f"{e:g}"
     if isinstance(e, Leaf):
-        return getattr(e.sym, "name", "time")
+        return name(e.sym) if name is not None else getattr(e.sym, "name", "time")
     if isinstance(e, Op):
+        args = [to_text(a, name) for a in e.args]
         if e.op in _INFIX:
-            return f"({to_text(e.args[0])}{_INFIX[e.op]}{to_text(e.args[1])})"
+            return f"({args[0]}{_INFIX[e.op]}{args[1]})"
         if e.op == "neg":
-            return f"-{to_text(e.args[0])}"
+            return f"-{args[0]}"
         if e.op == "not":
-            return f"not {to_text(e.args[0])}"
-        return f"{e.op}({', '.join(to_text(a) for a in e.args)})"
+            return f"not {args[0]}"
+        return f"{e.op}({', '.join(args)})"
     return str(e)
