@@ -24,7 +24,9 @@ from .expr import (
     HYBRID_NODES,
     Equation,
     Expr,
+    Leaf,
     Number,
+    Op,
     alias_signs,
     lower_group,
     shape_of,
@@ -63,7 +65,9 @@ class _Flattener(ConnectionLowering):
         self.columns: list[ca.SX] = []            # the residuals of self.equations, stacked
         self.draft: flatten_hybrid.HybridDraft | None = None
         self.slot: dict[int, int] = {}            # id(Symbol) -> index in discretes
-        self.full: dict[int, str] = {}            # id(Symbol) -> dotted name
+        self._full: dict[int, str] | None = None  # id(Symbol) -> dotted name (see full)
+        self._full_of = 0                         # len(collected) when _full was made
+        self.collected: list[tuple[Symbol, FlatVariable]] = []   # every symbol, flat entry
         self.groups: dict[Any, list] = {}         # equation shape -> members (as written)
         self.blocks: list[tuple[ArrayEquation, str]] = []   # array equations lowered whole
         self.initial_sources: list[tuple[Equation, str]] = []   # initial equations as written
@@ -173,6 +177,15 @@ class _Flattener(ConnectionLowering):
         return EquationSources(self.groups, self.draft, bindings, links, self.initial_sources,
                                self.blocks)
 
+    @property
+    def full(self) -> dict[int, str]:
+        """id(Symbol) -> dotted name of the symbols collected so far; made on first use
+        (messages, hybrid parts and bound parameters need it, most models never do)."""
+        if self._full is None or self._full_of != len(self.collected):
+            self._full = {id(sym): fv.name for sym, fv in self.collected}
+            self._full_of = len(self.collected)
+        return self._full
+
     def where(self, elem: Element) -> str:
         """``path (Class)`` of an element, for equation origins and messages."""
         text = self.origins.get(id(elem))
@@ -189,13 +202,13 @@ class _Flattener(ConnectionLowering):
         parameters: list[FlatVariable] = []
         inputs: list[FlatVariable] = []
         discretes: list[FlatVariable] = []
-        symbols: list[tuple[Symbol, FlatVariable]] = []
+        symbols = self.collected
         var_entries: list[int] = []                       # positions in symbols, by kind
         par_entries: list[int] = []
         hybrid = self.draft is not None
         targets = self.draft.targets if hybrid else {}
         top_connectors = {id(c) for c in self.top._children.values() if isinstance(c, Connector)}
-        full_names, var_of, paths = self.full, self.var_of, self.paths
+        var_of, paths = self.var_of, self.paths
         add_symbol, add_variable, add_entry = symbols.append, variables.append, var_entries.append
         for elem in self.elements:
             path = paths[id(elem)]
@@ -206,7 +219,6 @@ class _Flattener(ConnectionLowering):
                 full = prefix + sym.name
                 decl = sym.decl
                 kind = decl.kind
-                full_names[id(sym)] = full
                 if hybrid and id(sym) in targets:
                     self.slot[id(sym)] = len(discretes)
                     fv = FlatVariable(full, None, decl, owner)
@@ -314,16 +326,16 @@ class _Flattener(ConnectionLowering):
             if isinstance(eq, ArrayEquation):
                 self.blocks.append((eq, where))
                 continue
-            if isinstance(eq, Equation):
-                if isinstance(eq.lhs, (ca.SX, ca.MX)) or isinstance(eq.rhs, (ca.SX, ca.MX)):
-                    slow.append((to_sx(eq.lhs) - to_sx(eq.rhs), where))
-                    continue
+            if type(eq) is Equation:
                 leaves: list = []
                 consts: list = []
                 try:
                     key = (_side_shape(eq.lhs, leaves, consts),
                            _side_shape(eq.rhs, leaves, consts))
                 except TypeError:
+                    if isinstance(eq.lhs, (ca.SX, ca.MX)) or isinstance(eq.rhs, (ca.SX, ca.MX)):
+                        slow.append((to_sx(eq.lhs) - to_sx(eq.rhs), where))
+                        continue
                     raise EquationError(f"{where}: cannot use {eq!r} as an equation") from None
                 if not leaves:
                     raise EquationError(f"{where}: equation {eq!r} has no variables")
@@ -368,10 +380,18 @@ class _Flattener(ConnectionLowering):
         res = ca.SX(lhs - rhs)
         signs = alias_signs(shape_l, shape_r)
         if signs:
+            ratio = -signs[1] / signs[0]             # sa*a + sb*b = 0: a = ratio*b
+            var_of = self.var_of.get
+            add = self.equations.append
             for k, (leaves, consts, where, _) in enumerate(members):
-                alias = None if any(consts) else \
-                    self._alias_of(signs[0], leaves[0], signs[1], leaves[1])
-                self.equations.append(FlatEquation(None, where, alias, at=(res, k)))
+                alias = None
+                if not any(consts):
+                    a, b = leaves
+                    ia, ib = var_of(id(a)), var_of(id(b))
+                    if ia is not None and ib is not None and ia != ib \
+                            and a.der_of is None and b.der_of is None:
+                        alias = (ia, ib, ratio)
+                add(FlatEquation(None, where, alias, at=(res, k)))
         else:
             self.equations.extend(FlatEquation(None, m[2], at=(res, k))
                                   for k, m in enumerate(members))
@@ -418,7 +438,15 @@ class _Flattener(ConnectionLowering):
 
 
 def _side_shape(side: Any, leaves: list, consts: list) -> Any:
-    if isinstance(side, Number):
+    """:func:`shape_of` of one side of an equation (an Expr or a number); TypeError for
+    anything else (CasADi sides take the slow path)."""
+    kind = type(side)
+    if kind is Leaf:
+        leaves.append(side.sym)
+        return "L"
+    if kind is Op:
+        return (side.op, *[shape_of(a, leaves, consts) for a in side.args])
+    if kind is float or isinstance(side, Number):
         consts.append(float(side))
         return "C"
     if isinstance(side, Expr):
