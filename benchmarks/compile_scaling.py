@@ -4,10 +4,12 @@ coupled inertia pairs, which needs index reduction in every cell). Prints second
 the fitted growth exponent (time ~ equations^k).
 
     python benchmarks/compile_scaling.py
+    python benchmarks/compile_scaling.py --json 3 120 1200   # ladder rows, best of 3, as JSON
 """
 
 from __future__ import annotations
 
+import json
 import sys
 import time
 from pathlib import Path
@@ -50,7 +52,28 @@ def measure(factory, n: int) -> tuple[int, float, dict[str, float]]:
     return compiled.n_flat_equations, time.perf_counter() - t0, compiled.timings
 
 
+def ladder_rows(sizes: list[int], repeat: int) -> list[dict]:
+    """Compile the RC ladder of each size ``repeat`` times (best kept): equations, seconds
+    and microseconds per equation."""
+    import gc
+
+    measure(rc_ladder, 10)                                   # warm: unit registry, imports
+    rows = []
+    for n in sizes:
+        best = float("inf")
+        for _ in range(repeat):
+            gc.collect()
+            n_eq, secs, _ = measure(rc_ladder, n)
+            best = min(best, secs)
+        rows.append({"cells": n, "equations": n_eq, "seconds": best,
+                     "us_per_equation": 1e6 * best / n_eq})
+    return rows
+
+
 def main() -> None:
+    if len(sys.argv) > 1 and sys.argv[1] == "--json":     # --json REPEAT N...: ladder rows
+        print(json.dumps(ladder_rows([int(a) for a in sys.argv[3:]], int(sys.argv[2]))))
+        return
     for label, factory, sizes in (("RC ladder", rc_ladder, (120, 1200, 12000)),
                                   ("inertia chain (index 2)", inertia_chain, (40, 400, 4000))):
         print(f"{label}:")

@@ -23,6 +23,7 @@ import gc
 import json
 import math
 import platform
+import subprocess
 import sys
 import tempfile
 import time
@@ -42,7 +43,8 @@ _METHOD = ("one run; ratios against baselines measured in the same run; the ladd
            "`simulate` and its hand-written CasADi/CVODES run (which builds its integrator, "
            "about 2 ms, each time) alternate, best of 10; the CS FMU and native runs "
            "alternate, best of 10 (they take milliseconds); the master and fmucontainer "
-           "alternate, best of 5; each compile-scaling size is compiled 3 times, best kept")
+           "alternate, best of 5; the compile-scaling sizes are compiled 3 times each, best kept, "
+           "in a fresh interpreter")
 #: repetitions of the short comparisons, whatever --repeat says: a 30-ms run is cheap to
 #: repeat, and its minimum is what the shared machine's noise leaves alone
 FMU_REPEAT, MASTER_REPEAT = 10, 5
@@ -294,21 +296,16 @@ def fmu_cs_vs_native(repeat: int) -> dict:
 
 
 def compile_rows(sizes: list[int]) -> dict:
-    from compile_scaling import measure
-    from rc_ladder import rc_ladder
-
-    measure(rc_ladder, 10)                                   # warm: unit registry, imports
-    rows = []
-    for n in sizes:
-        secs = math.inf
-        for _ in range(COMPILE_REPEAT):
-            gc.collect()
-            n_eq, once, _ = measure(rc_ladder, n)
-            secs = min(secs, once)
-        rows.append({"cells": n, "equations": n_eq, "seconds": secs,
-                     "us_per_equation": 1e6 * secs / n_eq})
-        print(f"  compile: {n_eq} equations in {secs:.3f} s ({rows[-1]['us_per_equation']:.1f} "
-              "us/eq)", flush=True)
+    """Compile-scaling rows measured in a fresh interpreter: after the 10^5-section runs
+    above this process holds gigabytes of freed, fragmented memory, which slows compiling
+    by about 8 %, and a model is usually compiled in a new session."""
+    out = subprocess.run([sys.executable, str(HERE / "compile_scaling.py"), "--json",
+                          str(COMPILE_REPEAT), *map(str, sizes)],
+                         capture_output=True, text=True, check=True, cwd=HERE.parent)
+    rows = json.loads(out.stdout.strip().splitlines()[-1])
+    for r in rows:
+        print(f"  compile: {r['equations']} equations in {r['seconds']:.3f} s "
+              f"({r['us_per_equation']:.1f} us/eq)", flush=True)
     k = float(np.polyfit(np.log([r["equations"] for r in rows]),
                          np.log([r["seconds"] for r in rows]), 1)[0]) if len(rows) > 1 else None
     return {"rows": rows, "growth_exponent": k}
