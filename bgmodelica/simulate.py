@@ -174,8 +174,7 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
             "timings": dict(compiled.timings), "solver": solver, "solver_choice": choice,
             **solver_meta, "stats": stats,
             "states": list(dae.state_names), "init_notes": init.notes}
-    kept = set(names)
-    aliases = {a: rep for a, rep in flat.aliases.items() if rep[0] in kept}
+    aliases = _kept_aliases(dae, flat, obs_idx, names)
     result = Result(grid[:n_ok], values, names, aliases, params_out, dict(units), meta)
     if not _finite_run(dae, obs_idx, grid[:n_ok], xs, zs, p):
         check_result(result, dae, p)            # names the variable and time
@@ -200,12 +199,25 @@ def _units_by_name(dae: CasadiDAE, flat: Any) -> dict[str, str]:
     return seen[1]
 
 
+def _kept_aliases(dae: CasadiDAE, flat: Any, obs_idx: list[int],
+                  names: list[str]) -> dict[str, tuple[str, float]]:
+    """The aliases of the recorded variables ``names`` (a copy; the selection is made once
+    per model and output set)."""
+    key = ("kept aliases", tuple(obs_idx))
+    seen = dae.cache.get(key)
+    if seen is None or seen[0] is not flat.aliases:
+        kept = set(names)
+        seen = dae.cache[key] = (flat.aliases, {a: rep for a, rep in flat.aliases.items()
+                                                if rep[0] in kept})
+    return dict(seen[1])
+
+
 def _finite_run(dae: CasadiDAE, obs_idx: list[int], times: np.ndarray, xs: np.ndarray,
                 zs: np.ndarray, p: np.ndarray) -> bool:
     """Whether every recorded value is finite, evaluating only the variables that can turn
     non-finite for finite states (:func:`bgmodelica.diagnose.unsafe_outputs`); the others
     stay lazy (computed when first read)."""
-    if not (np.all(np.isfinite(xs)) and np.all(np.isfinite(zs))):
+    if not (_all_finite(xs) and _all_finite(zs)):
         return False
     if "unsafe_observed" in dae.cache:
         unsafe = [k for k in obs_idx if k in dae.cache["unsafe_observed"]]
@@ -224,6 +236,15 @@ def _finite_run(dae: CasadiDAE, obs_idx: list[int], times: np.ndarray, xs: np.nd
         return True
     with np.errstate(all="ignore"):
         return bool(np.all(np.isfinite(_observer(dae, unsafe)(times, xs, zs, p))))
+
+
+def _all_finite(a: np.ndarray) -> bool:
+    """Whether every entry of ``a`` is finite: its sum is (one pass, no temporary array; a
+    sum that overflows is checked entry by entry)."""
+    with np.errstate(all="ignore"):
+        if np.isfinite(np.sum(a)):
+            return True
+    return bool(np.all(np.isfinite(a)))
 
 
 def _split_overrides(dae: CasadiDAE, params: dict[str, Any]):

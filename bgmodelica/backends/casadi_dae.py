@@ -65,7 +65,12 @@ class CasadiDAE:
 
     def parameter_values(self, p: np.ndarray) -> dict[str, float]:
         """Every parameter's value for the vector ``p``, bound ones included."""
-        out = {q.name: float(v) for q, v in zip(self.parameters, p, strict=False)}
+        names = self.cache.get("parameter names")
+        if names is None or names[0] is not self.parameters:
+            names = self.cache["parameter names"] = (self.parameters,
+                                                     [q.name for q in self.parameters])
+        values = np.asarray(p, dtype=float).ravel()[:len(names[1])].tolist()
+        out = dict(zip(names[1], values, strict=True))
         if self.bound:
             if "bound_values" not in self.cache:
                 free = ca.vertcat(*[q.sx for q in self.parameters]) if self.parameters \

@@ -23,3 +23,20 @@ def test_unsafe_outputs_by_operation_and_by_what_varies():
     assert unsafe_outputs(f, (0,)) == [0, 2, 4, 7]
     assert unsafe_outputs(f, (0, 1)) == [0, 1, 2, 3, 4, 7]     # p varies too
     assert unsafe_outputs(f, ()) == []
+
+
+def test_all_finite_is_exact_when_the_sum_overflows_or_cancels():
+    import numpy as np
+
+    from bgmodelica.simulate import _all_finite
+
+    assert _all_finite(np.ones((3, 4)))
+    assert _all_finite(np.full((2, 3), 1e308))               # the sum overflows: all finite
+    assert _all_finite(np.zeros((0, 5)))
+    for bad in (np.nan, np.inf, -np.inf):
+        a = np.ones((3, 4))
+        a[1, 2] = bad
+        assert not _all_finite(a)
+    a = np.ones(6)
+    a[0], a[1] = np.inf, -np.inf                              # the sum is nan, not inf
+    assert not _all_finite(a)
