@@ -13,6 +13,9 @@ from __future__ import annotations
 from typing import Any
 
 import casadi as ca
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
 from ..errors import ConnectError
 from .component import Component, Connector
@@ -27,71 +30,60 @@ class ConnectionLowering:
     (``pos``, ``var_of``, ``all_sx``), and append to ``equations`` and ``columns``."""
 
     def _connection_equations(self) -> None:
-        parent: dict[tuple[int, int], tuple[int, int]] = {}
-
-        def find(x):
-            parent.setdefault(x, x)
-            root = x
-            while parent[root] != root:
-                root = parent[root]
-            while parent[x] != root:
-                parent[x], x = root, parent[x]
-            return root
-
-        connectors: dict[int, Connector] = {}
+        connectors = [e for e in self.elements if isinstance(e, Connector)]   # tree order
+        index = {id(c): k for k, c in enumerate(connectors)}
+        parents = self.parents
+        heads: list[int] = []                 # node = 2*connector + side (1: outside)
+        tails: list[int] = []
         signal_links: list[tuple[Any, Any, Component]] = []
         for conn, ctx in self.connections:
-            if conn.a is conn.b or (not isinstance(conn.a, Connector)
-                                    and _symbol(conn.a) is _symbol(conn.b)):
-                end = self.paths.get(id(conn.a)) if isinstance(conn.a, Connector) \
-                    else self.full.get(id(_symbol(conn.a)), "?")
+            a, b = conn.a, conn.b
+            if a is b or (not isinstance(a, Connector) and _symbol(a) is _symbol(b)):
+                end = self.paths.get(id(a)) if isinstance(a, Connector) \
+                    else self.full.get(id(_symbol(a)), "?")
                 raise ConnectError(f"{self.where(ctx)}: connect({end}, {end}) connects {end} "
                                    "to itself")
-            ends = []
-            for end in (conn.a, conn.b):
+            nodes = []
+            for end in (a, b):
                 if isinstance(end, Connector):
-                    if id(end) not in self.paths:
+                    k = index.get(id(end))
+                    if k is None:
                         raise ConnectError(
                             f"{self.where(ctx)}: connect() uses a {type(end).__name__} that is "
                             "not part of the model (add its component to the model first)")
-                    side = 1 if self.parents.get(id(end)) is ctx else 0   # 1 = outside
-                    connectors[id(end)] = end
-                    ends.append((id(end), side))
-            if len(ends) == 2:
-                parent[find(ends[0])] = find(ends[1])
+                    nodes.append(2 * k + (parents.get(id(end)) is ctx))
+            if len(nodes) == 2:
+                heads.append(nodes[1])
+                tails.append(nodes[0])
             else:
-                signal_links.append((conn.a, conn.b, ctx))
-        for elem in self.elements:
-            if isinstance(elem, Connector):
-                connectors[id(elem)] = elem
-                find((id(elem), 0))
-        sets: dict[tuple[int, int], list[tuple[int, int]]] = {}
-        for key in list(parent):
-            sets.setdefault(find(key), []).append(key)
+                signal_links.append((a, b, ctx))
+        paths = [self.paths[id(c)] for c in connectors]
         pairs = _Pairs()
-        for members in sets.values():
-            self._one_set(members, connectors, pairs)
+        for members in connection_sets(len(connectors), heads, tails, paths):
+            self._one_set(members, connectors, paths, pairs)
         for a, b, ctx in signal_links:
             sa, sb = _symbol(a), _symbol(b)
             pairs.add(sa, sb, -1.0, f"connect in {self.where(ctx)}")
         self._emit_pairs(pairs)
 
-    def _one_set(self, members, connectors, pairs: _Pairs) -> None:
-        members.sort(key=lambda m: self.paths[m[0]])
-        first = connectors[members[0][0]]
+    def _one_set(self, members: list[int], connectors: list[Connector], paths: list[str],
+                 pairs: _Pairs) -> None:
+        """The equations of one connection set; ``members``: its nodes (2*connector + side),
+        in the order of their connectors' paths."""
+        first = connectors[members[0] >> 1]
         if len(members) > 1:
-            names = " -- ".join(self.paths[m[0]] for m in members[:6])
+            names = " -- ".join(paths[m >> 1] for m in members[:6])
             more = f" -- ... ({len(members)} connectors)" if len(members) > 6 else ""
             origin = f"connection set {{{names}{more}}}"
         else:
-            origin = f"unconnected connector {self.paths[members[0][0]]}"
+            origin = f"unconnected connector {paths[members[0] >> 1]}"
         for var_name, sym in first._symbols.items():
-            syms = [connectors[cid]._symbols[var_name] for cid, _ in members]
+            syms = [connectors[m >> 1]._symbols[var_name] for m in members]
             if sym.decl.kind != KIND_FLOW:
                 for other in syms[1:]:
                     pairs.add(syms[0], other, -1.0, origin)
                 continue
-            signs = [-1.0 if side else 1.0 for _, side in members]
+            signs = [-1.0 if m & 1 else 1.0 for m in members]
             if len(syms) == 2:
                 pairs.add(syms[0], syms[1], signs[0] * signs[1], origin)
             else:
@@ -101,12 +93,11 @@ class ConnectionLowering:
         """Residuals ``a + c*b`` of all two-symbol connection equations in one operation,
         then the flow sums of larger sets as one sparse matrix product."""
         if pairs.sums:
-            rows, cols, vals = [], [], []
-            for k, (syms, signs, _) in enumerate(pairs.sums):
-                for sym, sgn in zip(syms, signs, strict=True):
-                    rows.append(k)
-                    cols.append(self.pos[id(sym)])
-                    vals.append(sgn)
+            pos = self.pos
+            cols = [pos[id(sym)] for syms, _, _ in pairs.sums for sym in syms]
+            vals = [sgn for _, signs, _ in pairs.sums for sgn in signs]
+            rows = np.repeat(np.arange(len(pairs.sums)),
+                             [len(syms) for syms, _, _ in pairs.sums]).tolist()
             # DM.triplet keeps each value with its (row, col); DM(Sparsity.triplet(...), vals)
             # would not (the sparsity is sorted column-major)
             sel = ca.DM.triplet(rows, cols, ca.DM(vals), len(pairs.sums), self.all_sx.numel())
@@ -148,6 +139,33 @@ class _Pairs:
         self.b.append(b)
         self.coef.append(coef)
         self.origin.append(origin)
+
+
+def connection_sets(n: int, heads: list[int], tails: list[int],
+                    paths: list[str]) -> list[list[int]]:
+    """The connection sets of ``n`` connectors joined by the links ``tails[k] -- heads[k]``
+    between nodes ``2*connector + side`` (side 1: the connector seen from outside its
+    component). Every connector's inside node is in a set, an outside node only if linked.
+    Sets come in the order of their first node in the sequence ``heads[0], tails[0],
+    heads[1], ...`` followed by the inside nodes; each set's nodes by their connectors'
+    ``paths``, then in that sequence."""
+    if n == 0:
+        return []
+    seq = np.concatenate((np.column_stack((np.asarray(heads, dtype=np.int64),
+                                           np.asarray(tails, dtype=np.int64))).ravel(),
+                          2 * np.arange(n, dtype=np.int64)))
+    nodes, first = np.unique(seq, return_index=True)           # present nodes, first seen
+    graph = sp.coo_matrix((np.ones(len(heads)), (heads, tails)), shape=(2 * n, 2 * n))
+    _, label = connected_components(graph, directed=False)
+    label = label[nodes]
+    set_first = np.full(2 * n, len(seq), dtype=np.int64)
+    np.minimum.at(set_first, label, first)                     # each set: its first node
+    by_path = np.empty(n, dtype=np.int64)
+    by_path[sorted(range(n), key=paths.__getitem__)] = np.arange(n)
+    order = np.lexsort((first, by_path[nodes >> 1], set_first[label]))
+    nodes, label = nodes[order], label[order]
+    cuts = np.flatnonzero(label[1:] != label[:-1]) + 1
+    return [part.tolist() for part in np.split(nodes, cuts)]
 
 
 def _symbol(x: Any) -> Symbol:
