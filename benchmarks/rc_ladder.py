@@ -7,6 +7,7 @@ and solve seconds per n, and the stage split.
 
     python benchmarks/rc_ladder.py [n ...]
     python benchmarks/rc_ladder.py --units [n]     # compile time with and without the unit check
+    python benchmarks/rc_ladder.py --forms [n]     # the three forms against the hand-written floor
 """
 
 from __future__ import annotations
@@ -70,9 +71,47 @@ def units_overhead(n: int, reps: int = 3) -> None:
           f"{check:.3f} s ({100 * check / best['off']:.1f}%)")
 
 
+def forms(n: int, reps: int = 2) -> None:
+    """The three forms of the ladder (array equations, arrays of components, a component per
+    section) and the hand-written CasADi/CVODES floor, alternating, best of ``reps`` each:
+    construct, compile and 10-s simulation seconds."""
+    import gc
+
+    from run_all import ladder_by_hand
+
+    from library.examples.circuits import RCLadderArrays, RCLadderVector
+
+    best: dict[str, tuple[float, ...]] = {}
+    floor = float("inf")
+    for _ in range(reps):
+        for cls in (RCLadderVector, RCLadderArrays, RCLadder):
+            gc.collect()
+            t0 = time.perf_counter()
+            model = cls(n)
+            t1 = time.perf_counter()
+            compiled = bg.compile(model)
+            t2 = time.perf_counter()
+            bg.simulate(compiled, stop_time=10.0, interval=0.01, rtol=1e-6, atol=1e-6,
+                        outputs=[compiled.dae.state_names[0]])
+            t3 = time.perf_counter()
+            row = (t1 - t0, t2 - t1, t3 - t2, t3 - t0)
+            if cls.__name__ not in best or row[3] < best[cls.__name__][3]:
+                best[cls.__name__] = row
+            del compiled, model
+        gc.collect()
+        floor = min(floor, ladder_by_hand(n)["total"])
+    print(f"n={n}, CasADi/CVODES by hand {floor:.3f} s")
+    print(f"{'form':>15} {'construct':>10} {'compile':>8} {'simulate':>9} {'total':>7}  ratio")
+    for name, (a, b, c, d) in best.items():
+        print(f"{name:>15} {a:>10.3f} {b:>8.3f} {c:>9.3f} {d:>7.3f}  {d / floor:.2f}x")
+
+
 def main(argv: list[str]) -> None:
     if argv[:1] == ["--units"]:
         units_overhead(int(argv[1]) if len(argv) > 1 else 10000)
+        return
+    if argv[:1] == ["--forms"]:
+        forms(int(argv[1]) if len(argv) > 1 else 10000)
         return
     sizes = [int(a) for a in argv] or [10, 100, 1000, 10000]
     print(f"{'n':>6} {'build[s]':>9} {'solve[s]':>9} {'total[s]':>9}  stages")
