@@ -469,7 +469,7 @@ def _selection(compiled: CompiledModel, dynamic: bool, start_over: dict[str, Any
     selector = _selector(compiled)
     if selector is None:
         return None
-    from .events.loop import Selection
+    from .events.selection import Selection
 
     return Selection(selector, selector.base, "switch" if dynamic else "check",
                      (lambda d: _with_starts(d, start_over)) if start_over else None,

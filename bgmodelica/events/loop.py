@@ -11,6 +11,9 @@ event is taken at the right end of the bracket, where the relation has its new v
 
 At every event the result gets two rows with the same time: the left limit (values before
 the event) and the right limit (after the event iteration and re-initialization).
+
+The indicators and the location of crossings are in :mod:`.crossings`, dynamic state
+selection between events in :mod:`.selection`.
 """
 
 from __future__ import annotations
@@ -27,11 +30,13 @@ from ..backends.casadi_dae import CasadiDAE
 from ..backends.casadi_init import initialize
 from ..core.flatmodel import HybridPart
 from ..errors import SimulationError
+from .crossings import CrossingMixin
 from .fast import Fast
 from .functions import HybridFunctions, build
 from .integrators import integrator as _integrator
 from .integrators import quiet_stderr as _quiet_stderr
 from .schedule import is_sample_instant, next_sample, table_coefficients
+from .selection import Selection, StateSelectionMixin
 
 
 class EventError(SimulationError):
@@ -52,35 +57,13 @@ class EventOptions:
 
 
 @dataclass
-class Selection:
-    """Dynamic state selection inside the event loop (see :mod:`bgmodelica.dynamic_selection`).
-
-    selector: the model's StateSelector; current: the variant in use; mode: "switch" (change
-    the states when the pivot test says so) or "check" (keep the states; raise when their
-    pivots degenerate below ``fail_ratio`` times the best); prepare: applies start-value
-    overrides to a variant's DAE; spacing: largest time between two pivot checks [s]."""
-
-    selector: Any
-    current: Any
-    mode: str = "switch"
-    prepare: Any = None
-    spacing: float = math.inf
-    fail_ratio: float = 1e-3
-
-    @property
-    def stretch(self) -> float:
-        """Longest integration between restarts [s] (100 pivot checks)."""
-        return 100.0 * self.spacing
-
-
-@dataclass
 class EventLog:
     times: list[float] = field(default_factory=list)
     kinds: list[str] = field(default_factory=list)
     causes: dict[str, int] = field(default_factory=dict)
 
 
-class HybridSimulator:
+class HybridSimulator(CrossingMixin, StateSelectionMixin):
     """Simulate one hybrid model for one parameter vector (see the module docstring)."""
 
     def __init__(self, dae: CasadiDAE, p: np.ndarray, rtol: float, atol: float,
@@ -283,75 +266,6 @@ class HybridSimulator:
         Z = res[1].reshape(n_t, nz).T.copy() if nz else np.zeros((0, n_t))
         return X, Z
 
-    # -- dynamic state selection ------------------------------------------------------------
-    def _selection_column(self, ts, X, Z, z, cols) -> int | None:
-        """First pivot-check column among ``cols`` where the state choice must change."""
-        sel = self.selection
-        nz = self.dae.z.numel()
-        nv = self.dae.n_variables
-        for c in cols:
-            t = float(ts[c])
-            values = self._step_fast(t, X[:, c], Z[:, c] if nz else z, self.p)[6][:nv]
-            if sel.mode == "check":
-                now, best, _, _ = sel.selector.assess(sel.current, values, self.p, t)
-                if not now >= sel.fail_ratio * best:
-                    raise SimulationError(
-                        f"the state choice ({', '.join(self.dae.state_names)}) degenerates at "
-                        f"t = {t:.6g} s (pivot {now:.2g}, best {best:.2g}): with dynamic=False "
-                        "the states cannot change; simulate with dynamic=True (the default) or "
-                        "choose other states with state_select", t)
-                continue
-            nxt = sel.selector.check(sel.current, values, self.p, t)
-            if nxt is not sel.current:
-                self._pending = nxt
-                return c
-        return None
-
-    def _initial_selection(self, t: float, x, z):
-        sel = self.selection
-        nv = self.dae.n_variables
-        values = self._step_fast(t, x, z, self.p)[6][:nv].copy()
-        bad = ~np.isfinite(values)
-        if bad.any():
-            starts = [float(getattr(v.decl, "start", 0.0))
-                      for v in sel.current.reduced.model.variables]
-            values[bad] = np.asarray(starts)[bad]
-        if sel.mode == "check":
-            return x, z
-        nxt = sel.selector.check(sel.current, values, self.p, t)
-        if nxt is sel.current:
-            return x, z
-        self._use_variant(nxt)
-        x, z = self._consistent(t, None)
-        return x, z
-
-    def _use_variant(self, compiled) -> None:
-        sel = self.selection
-        dae = compiled.dae
-        if sel.prepare is not None:
-            dae = sel.prepare(dae)
-        if dae.hybrid is None:
-            dae = replace(dae, hybrid=HybridPart())
-        sel.current = compiled
-        self.dae = dae
-        self.fn = build(dae)
-        self._step_fast = Fast(self.fn.step)
-        self._ind_fast = Fast(self.fn.indicators)
-        self._one = None
-        self._z_guess = None
-
-    def _switch(self, t: float, x, z):
-        """Continue with the variant chosen by the pivot test, from the current values."""
-        old = self.dae
-        values = self._step_fast(t, x, z, self.p)[6].copy()
-        self._use_variant(self._pending)
-        idx = old.observed_index
-        x_new = np.array([values[idx[n]] for n in self.dae.state_names])
-        self._z_guess = np.array([values[idx[n]] for n in self.dae.algebraic_names])
-        z_new = self._solve_z(t, x_new) if self.fn.alg_solver is not None else np.zeros(0)
-        self.log.causes["state selection"] = self.log.causes.get("state selection", 0) + 1
-        return x_new, z_new
-
     def _shifted(self, offsets: tuple[float, ...]) -> Fast:
         """An integrator from t0 (a parameter) to ``t0 + offsets`` (cached)."""
         cache = self.dae.cache.setdefault(("shifted", self._opts_key), {})
@@ -365,49 +279,6 @@ class HybridSimulator:
             cache[offsets] = F
         return F
 
-    def _locate(self, lo_t, lo_x, lo_z, g_lo, hi_t, hi_x, hi_z, g_hi, frozen):
-        """Illinois iteration on the earliest crossing indicator in [lo_t, hi_t]."""
-        fn = self.fn
-        strict = fn.strict[fn.state_rel]
-        tol = self.opts.event_tol * max(1.0, abs(hi_t))
-        g_lo = np.array(g_lo, dtype=float)
-        g_hi = np.array(g_hi, dtype=float)
-        side = 0
-        widths = [hi_t - lo_t]
-        for _ in range(400):
-            if hi_t - lo_t <= tol:
-                break
-            changed = self._values(g_hi[:, None], strict)[:, 0] != frozen
-            cand = hi_t
-            for k in np.nonzero(changed)[0]:
-                a, b = g_lo[k], g_hi[k]
-                if a != b:
-                    tc = lo_t + (hi_t - lo_t) * a / (a - b)
-                    cand = min(cand, tc)
-            margin = 0.1 * tol
-            cand = min(max(cand, lo_t + margin), hi_t - margin)
-            # safeguard: bisect when the bracket did not halve over the last three steps
-            # (an indicator that is exactly 0 at lo_t stalls the secant at lo_t)
-            if not (lo_t < cand < hi_t) or (len(widths) > 3 and widths[-1] > 0.5 * widths[-4]):
-                cand = 0.5 * (lo_t + hi_t)
-            xc, zc = self._integrate_one(lo_t, cand, lo_x, lo_z)
-            gc = self._ind(cand, xc, zc)
-            if (self._values(gc[:, None], strict)[:, 0] != frozen).any():
-                hi_t, hi_x, hi_z, g_hi = cand, xc, zc, gc
-                if side == 1:
-                    g_lo = g_lo * 0.5
-                side = 1
-            else:
-                lo_t, lo_x, lo_z, g_lo = cand, xc, zc, gc
-                if side == -1:
-                    g_hi = g_hi * 0.5
-                side = -1
-            widths.append(hi_t - lo_t)
-        changed = self._values(g_hi[:, None], strict)[:, 0] != frozen
-        cause = " and ".join(self.fn.relations[fn.state_rel[k]].text
-                             for k in np.nonzero(changed)[0][:3])
-        return hi_t, hi_x, hi_z, f"state:{cause}"
-
     def _integrate_one(self, t0, t1, x, z):
         if len(x) == 0:
             return x, self._solve_z(t1, x)
@@ -420,19 +291,6 @@ class HybridSimulator:
         res = self._one(x, z, pe)
         self.n_segments += 1
         return res[0].copy(), (res[1].copy() if self.dae.z.numel() else z)
-
-    def _ind(self, t, x, z) -> np.ndarray:
-        return self._ind_fast(t, x, z, self.p)[0].copy()
-
-    def _ind_map(self, m: int) -> ca.Function:
-        key = ("ind_map", m)
-        if key not in self.dae.cache:
-            self.dae.cache[key] = self.fn.indicators.map(m)
-        return self.dae.cache[key]
-
-    @staticmethod
-    def _values(g: np.ndarray, strict: np.ndarray) -> np.ndarray:
-        return np.where(strict[:, None], g > 0, g >= 0)
 
     # -- time events ------------------------------------------------------------------------
     def _next_time_event(self, t: float, stop: float) -> tuple[float, str | None]:
@@ -450,22 +308,6 @@ class HybridSimulator:
         if best > stop:
             return stop, None
         return best, kind
-
-    def _schedule_time_relations(self, t: float, g: np.ndarray, dgdt: np.ndarray) -> None:
-        """Next instant where a relation on time alone changes value."""
-        fn = self.fn
-        self._time_next = math.inf
-        for k in fn.time_rel:
-            a = dgdt[k]
-            if a == 0.0 or not math.isfinite(a):
-                continue
-            value = bool(self.p[fn.rel_slot[k]])
-            if value == (a > 0):
-                continue
-            ts = t - g[k] / a
-            if ts > t:
-                self._time_next = min(self._time_next, ts)
-                self._time_cause = fn.relations[k].text
 
     # -- events -----------------------------------------------------------------------------
     def _initialize(self, t0: float):
@@ -519,17 +361,6 @@ class HybridSimulator:
     def _step(self, t, x, z) -> list[np.ndarray]:
         """g, dgdt, cond, assign, reinit, pre, obs at (t, x, z) (copies)."""
         return [r.copy() for r in self._step_fast(t, x, z, self.p)]
-
-    def _relation_values(self, t: float, g: np.ndarray, dgdt: np.ndarray) -> np.ndarray:
-        """Relation values at an event instant: the sign of the indicator; for relations on
-        time alone at their crossing, the right limit (the sign of the slope)."""
-        fn = self.fn
-        vals = np.where(fn.strict, g > 0, g >= 0).astype(float)
-        for k in fn.time_rel:
-            a = dgdt[k]
-            if a != 0.0 and abs(g[k]) <= 1e-12 * abs(a) * max(1.0, abs(t)):
-                vals[k] = float(a > 0)
-        return vals
 
     def _set_pre_from(self, out) -> None:
         if self.fn.pre_slot.size:

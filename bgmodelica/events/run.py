@@ -11,7 +11,8 @@ from ..backends.casadi_dae import CasadiDAE
 from ..errors import SimulationError
 from ..result import Result
 from .inputs import with_input_tables
-from .loop import HybridSimulator, Selection
+from .loop import HybridSimulator
+from .selection import Selection
 
 
 def simulate_hybrid(compiled, dae: CasadiDAE, p: np.ndarray, grid: np.ndarray, *, rtol: float,
