@@ -1,7 +1,9 @@
 """Parse Modelica text (the subset in ``grammar.lark``) into the syntax tree of :mod:`.ast`.
 
 The grammar is compiled once per process by lark's LALR(1) parser generator. Syntax errors
-become :class:`ModelicaSyntaxError` with ``file:line:column`` and what was expected.
+become :class:`ModelicaSyntaxError` with ``file:line:column`` and what was expected. The rules
+for classes and elements are here, those for equations and expressions in
+:mod:`.expression_rules`.
 """
 
 from __future__ import annotations
@@ -11,11 +13,12 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-from lark import Lark, Token, Transformer, v_args
+from lark import Lark, Token, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, VisitError
 
 from . import ast as A
 from .errors import ModelicaError, ModelicaSyntaxError
+from .expression_rules import ExpressionRules, ident_text, node_pos, token_pos
 
 _GRAMMAR = Path(__file__).with_name("grammar.lark")
 
@@ -44,51 +47,8 @@ def _lark() -> Lark:
                     maybe_placeholders=False)
 
 
-def _pos(meta: Any) -> A.Pos:
-    if getattr(meta, "empty", True):
-        return (0, 0)
-    return (meta.line, meta.column)
-
-
-def _tpos(tok: Token) -> A.Pos:
-    return (tok.line or 0, tok.column or 0)
-
-
-def _ident(tok: Token | str) -> str:
-    s = str(tok)
-    if s.startswith("'"):
-        return _unescape(s[1:-1])
-    return s
-
-
-def _unescape(s: str) -> str:
-    if "\\" not in s:
-        return s
-    out = []
-    i = 0
-    while i < len(s):
-        c = s[i]
-        if c == "\\" and i + 1 < len(s):
-            n = s[i + 1]
-            out.append({"n": "\n", "t": "\t", "r": "\r", "\\": "\\", '"': '"', "'": "'",
-                        "a": "\a", "b": "\b", "f": "\f", "v": "\v", "?": "?"}.get(n, n))
-            i += 2
-            continue
-        out.append(c)
-        i += 1
-    return "".join(out)
-
-
 class _ClassMod(tuple):
     """The argument list of a class modification (distinguished from other tuples)."""
-
-
-class _Named(tuple):
-    """``name = expression`` inside a function call."""
-
-
-class _Comprehension(tuple):
-    """``expression for indices``."""
 
 
 class _Section(tuple):
@@ -96,7 +56,7 @@ class _Section(tuple):
 
 
 @v_args(meta=True)
-class _ToAst(Transformer):
+class _ToAst(ExpressionRules):
     def __init__(self, file: str) -> None:
         super().__init__()
         self.file = file
@@ -116,7 +76,7 @@ class _ToAst(Transformer):
         return ch[0] if ch else ""
 
     def name(self, meta, ch):
-        return ".".join(_ident(t) for t in ch)
+        return ".".join(ident_text(t) for t in ch)
 
     def type_specifier(self, meta, ch):
         return ch[-1]
@@ -130,26 +90,26 @@ class _ToAst(Transformer):
         kind = ch[-2]
         cdef.kind = kind
         cdef.partial = any(isinstance(t, Token) and t.type == "PARTIAL" for t in ch)
-        cdef.pos = _pos(meta)
+        cdef.pos = node_pos(meta)
         cdef.file = self.file
         return cdef
 
     short_class_definition = class_definition
 
     def long_class_specifier(self, meta, ch):
-        name, desc, comp, end = _ident(ch[0]), ch[1], ch[2], _ident(ch[3])
+        name, desc, comp, end = ident_text(ch[0]), ch[1], ch[2], ident_text(ch[3])
         if name != end:
             raise ModelicaSyntaxError(self.file, ch[3].line, ch[3].column,
                                       f"class {name} is closed by 'end {end}' (expected "
                                       f"'end {name}')")
-        cdef = A.ClassDef(name, "", _pos(meta), description=desc, file=self.file, **comp)
+        cdef = A.ClassDef(name, "", node_pos(meta), description=desc, file=self.file, **comp)
         for el in cdef.elements:
             if isinstance(el, A.ClassDef):
                 el.parent = cdef
         return cdef
 
     def short_class_specifier(self, meta, ch):
-        name = _ident(ch[0])
+        name = ident_text(ch[0])
         prefix = ch[1]
         type_name = ch[2]
         dims: tuple = ()
@@ -159,14 +119,14 @@ class _ToAst(Transformer):
             if isinstance(c, list):
                 dims = tuple(c)
             elif isinstance(c, _ClassMod):
-                mod = A.Modification(tuple(c), None, _pos(meta))
+                mod = A.Modification(tuple(c), None, node_pos(meta))
             elif isinstance(c, tuple) and len(c) == 2:
                 desc, ann = c
-        return A.ClassDef(name, "", _pos(meta), description=desc, annotation=ann,
+        return A.ClassDef(name, "", node_pos(meta), description=desc, annotation=ann,
                           short=(prefix, type_name, dims, mod), file=self.file)
 
     def enum_class_specifier(self, meta, ch):
-        name = _ident(ch[0])
+        name = ident_text(ch[0])
         literals: tuple = ()
         desc = ""
         for c in ch[1:]:
@@ -174,7 +134,7 @@ class _ToAst(Transformer):
                 literals = tuple(c)
             elif isinstance(c, tuple) and len(c) == 2:
                 desc = c[0]
-        return A.ClassDef(name, "type", _pos(meta), description=desc, enum=literals,
+        return A.ClassDef(name, "type", node_pos(meta), description=desc, enum=literals,
                           file=self.file)
 
     def base_prefix(self, meta, ch):
@@ -184,7 +144,7 @@ class _ToAst(Transformer):
         return list(ch)
 
     def enumeration_literal(self, meta, ch):
-        return _ident(ch[0])
+        return ident_text(ch[0])
 
     def composition(self, meta, ch):
         out: dict[str, Any] = {"elements": [], "equations": [], "initial_equations": [],
@@ -217,14 +177,14 @@ class _ToAst(Transformer):
         return _Section(("initial", list(ch[1:])))
 
     def algorithm_section(self, meta, ch):
-        return _Section(("unsupported", A.Unsupported("algorithm section", _pos(meta))))
+        return _Section(("unsupported", A.Unsupported("algorithm section", node_pos(meta))))
 
     def initial_algorithm_section(self, meta, ch):
         return _Section(("unsupported", A.Unsupported("initial algorithm section",
-                                                      _pos(meta))))
+                                                      node_pos(meta))))
 
     def external_clause(self, meta, ch):
-        return _Section(("unsupported", A.Unsupported("external function", _pos(meta))))
+        return _Section(("unsupported", A.Unsupported("external function", node_pos(meta))))
 
     def element_list(self, meta, ch):
         out = []
@@ -257,20 +217,20 @@ class _ToAst(Transformer):
         return ("constrainedby", ch[0], ch[1] if len(ch) > 1 else None)
 
     def import_alias(self, meta, ch):
-        return A.Import(_ident(ch[0]), ch[1], False, _pos(meta))
+        return A.Import(ident_text(ch[0]), ch[1], False, node_pos(meta))
 
     def import_all(self, meta, ch):
-        return A.Import(None, ch[0], True, _pos(meta))
+        return A.Import(None, ch[0], True, node_pos(meta))
 
     def import_name(self, meta, ch):
-        return A.Import(None, ch[0], False, _pos(meta))
+        return A.Import(None, ch[0], False, node_pos(meta))
 
     def extends_clause(self, meta, ch):
         mod = None
         for c in ch[1:]:
             if isinstance(c, _ClassMod):
-                mod = A.Modification(tuple(c), None, _pos(meta))
-        return A.Extends(ch[0], mod, _pos(meta))
+                mod = A.Modification(tuple(c), None, node_pos(meta))
+        return A.Extends(ch[0], mod, node_pos(meta))
 
     def type_prefix(self, meta, ch):
         return str(ch[0])
@@ -319,7 +279,7 @@ class _ToAst(Transformer):
         return ("__cond__", ch[0])
 
     def declaration(self, meta, ch):
-        name = _ident(ch[0])
+        name = ident_text(ch[0])
         dims: tuple = ()
         mod = None
         for c in ch[1:]:
@@ -327,7 +287,7 @@ class _ToAst(Transformer):
                 mod = c
             elif isinstance(c, list):
                 dims = tuple(c)
-        return (name, dims, mod, _tpos(ch[0]))
+        return (name, dims, mod, token_pos(ch[0]))
 
     # -- modifications -----------------------------------------------------------------------
     def modification(self, meta, ch):
@@ -338,7 +298,7 @@ class _ToAst(Transformer):
                 args = tuple(c)
             else:
                 binding = c
-        return A.Modification(args, binding, _pos(meta))
+        return A.Modification(args, binding, node_pos(meta))
 
     def class_modification(self, meta, ch):
         return _ClassMod(ch)
@@ -350,201 +310,19 @@ class _ToAst(Transformer):
             target.each = "each" in flags
             target.final = "final" in flags
             return target
-        return A.Redeclare(target, "each" in flags, _pos(meta))
+        return A.Redeclare(target, "each" in flags, node_pos(meta))
 
     def element_modification(self, meta, ch):
         name = ch[0]
         mod = next((c for c in ch[1:] if isinstance(c, A.Modification)), None)
-        return A.ElementMod(name, mod, pos=_pos(meta))
+        return A.ElementMod(name, mod, pos=node_pos(meta))
 
     def element_redeclaration(self, meta, ch):
         flags = {str(t) for t in ch[:-1]}
-        return A.Redeclare(ch[-1], "each" in flags, _pos(meta))
+        return A.Redeclare(ch[-1], "each" in flags, node_pos(meta))
 
     def element_replaceable(self, meta, ch):
         return ch[1]
-
-    # -- equations ---------------------------------------------------------------------------
-    def equation(self, meta, ch):
-        return ch[0]
-
-    def simple_equation(self, meta, ch):
-        if len(ch) == 2:
-            return A.EqSimple(ch[0], ch[1], _pos(meta))
-        if isinstance(ch[0], A.Call):
-            return A.EqCall(ch[0], _pos(meta))
-        line, col = _pos(meta)
-        raise ModelicaSyntaxError(self.file, line, col,
-                                  "an equation must be 'expression = expression' or a call "
-                                  "such as connect(a, b)")
-
-    def if_equation(self, meta, ch):
-        cond = ch[0]
-        body = []
-        branches = []
-        otherwise: tuple = ()
-        for c in ch[1:]:
-            if isinstance(c, tuple) and c and c[0] == "__elseif__":
-                branches.append((c[1], c[2]))
-            elif isinstance(c, tuple) and c and c[0] == "__else__":
-                otherwise = c[1]
-            else:
-                body.append(c)
-        return A.EqIf(((cond, tuple(body)), *branches), otherwise, _pos(meta))
-
-    def elseif_equation(self, meta, ch):
-        return ("__elseif__", ch[0], tuple(ch[1:]))
-
-    def else_equation(self, meta, ch):
-        return ("__else__", tuple(ch))
-
-    def for_equation(self, meta, ch):
-        return A.EqFor(ch[0], tuple(ch[1:]), _pos(meta))
-
-    def when_equation(self, meta, ch):
-        cond = ch[0]
-        body = []
-        branches = []
-        for c in ch[1:]:
-            if isinstance(c, tuple) and c and c[0] == "__elsewhen__":
-                branches.append((c[1], c[2]))
-            else:
-                body.append(c)
-        return A.EqWhen(((cond, tuple(body)), *branches), _pos(meta))
-
-    def elsewhen_equation(self, meta, ch):
-        return ("__elsewhen__", ch[0], tuple(ch[1:]))
-
-    def for_indices(self, meta, ch):
-        return tuple(ch)
-
-    def for_index(self, meta, ch):
-        return (_ident(ch[0]), ch[1] if len(ch) > 1 else None)
-
-    def statement(self, meta, ch):
-        return A.Unsupported("algorithm statement", _pos(meta))
-
-    # -- expressions -------------------------------------------------------------------------
-    def if_expression(self, meta, ch):
-        branches = [(ch[0], ch[1])]
-        for c in ch[2:-1]:
-            branches.append(c)
-        return A.IfExpr(tuple(branches), ch[-1], _pos(meta))
-
-    def elseif_expression(self, meta, ch):
-        return (ch[0], ch[1])
-
-    def range(self, meta, ch):
-        items = [c for c in ch if not (isinstance(c, Token) and c.type == "COLON")]
-        if len(items) == 2:
-            return A.Range(items[0], None, items[1], _pos(meta))
-        return A.Range(items[0], items[1], items[2], _pos(meta))
-
-    def or_expr(self, meta, ch):
-        return A.BinOp("or", ch[0], ch[1], _pos(meta))
-
-    def and_expr(self, meta, ch):
-        return A.BinOp("and", ch[0], ch[1], _pos(meta))
-
-    def not_expr(self, meta, ch):
-        return A.Unary("not", ch[0], _pos(meta))
-
-    def relation(self, meta, ch):
-        return A.BinOp(str(ch[1]), ch[0], ch[2], _pos(meta))
-
-    def unary(self, meta, ch):
-        return A.Unary(str(ch[0]).lstrip("."), ch[1], _pos(meta))
-
-    def binary(self, meta, ch):
-        return A.BinOp(str(ch[1]), ch[0], ch[2], _pos(meta))
-
-    def number(self, meta, ch):
-        text = str(ch[0])
-        if any(c in text for c in ".eE"):
-            return A.Num(float(text), _tpos(ch[0]))
-        return A.Num(int(text), _tpos(ch[0]))
-
-    def string(self, meta, ch):
-        return A.Str(_unescape(str(ch[0])[1:-1]), _tpos(ch[0]))
-
-    def true(self, meta, ch):
-        return A.Bool(True, _pos(meta))
-
-    def false(self, meta, ch):
-        return A.Bool(False, _pos(meta))
-
-    def component_reference(self, meta, ch):
-        glob = bool(ch) and isinstance(ch[0], Token) and ch[0].type == "DOT"
-        parts = tuple(c for c in ch if not isinstance(c, Token))
-        return A.Ref(parts, _pos(meta), glob)
-
-    def ref_part(self, meta, ch):
-        return (_ident(ch[0]), tuple(ch[1]) if len(ch) > 1 else None)
-
-    def call(self, meta, ch):
-        ref, (args, kwargs, iterator) = ch
-        return A.Call(ref, args, kwargs, _pos(meta), iterator)
-
-    def function_call_args(self, meta, ch):
-        if not ch:
-            return ((), {}, None)
-        c = ch[0]
-        if isinstance(c, _Comprehension):
-            return ((), {}, (c[0], c[1]))
-        args, kwargs = [], {}
-        for a in c:
-            if isinstance(a, _Named):
-                kwargs[a[0]] = a[1]
-            else:
-                args.append(a)
-        return (tuple(args), kwargs, None)
-
-    def function_arguments(self, meta, ch):
-        return list(ch)
-
-    def comprehension_arguments(self, meta, ch):
-        return _Comprehension((ch[0], ch[1]))
-
-    def named_argument(self, meta, ch):
-        return _Named((_ident(ch[0]), ch[1]))
-
-    def function_argument_partial(self, meta, ch):
-        line, col = _pos(meta)
-        raise ModelicaSyntaxError(self.file, line, col,
-                                  "unsupported Modelica construct: functional arguments "
-                                  "('function f(...)' in a call)")
-
-    def array(self, meta, ch):
-        c = ch[0]
-        if isinstance(c, _Comprehension):
-            return A.ArrayComp(c[0], c[1], _pos(meta))
-        return A.ArrayLit(tuple(c), _pos(meta))
-
-    def array_arguments(self, meta, ch):
-        return list(ch)
-
-    def matrix(self, meta, ch):
-        return A.Matrix(tuple(tuple(r) for r in ch), _pos(meta))
-
-    def expression_list(self, meta, ch):
-        return list(ch)
-
-    def array_subscripts(self, meta, ch):
-        return list(ch)
-
-    def colon_subscript(self, meta, ch):
-        return A.Colon(_pos(meta))
-
-    def comment(self, meta, ch):
-        desc = ch[0] if ch and isinstance(ch[0], str) else ""
-        ann = next((c for c in ch if isinstance(c, A.Modification)), None)
-        return (desc, ann)
-
-    def string_comment(self, meta, ch):
-        return "".join(_unescape(str(t)[1:-1]) for t in ch if t.type == "STRING")
-
-    def annotation(self, meta, ch):
-        return A.Modification(tuple(ch[0]), None, _pos(meta))
 
 
 class _CompList(list):
