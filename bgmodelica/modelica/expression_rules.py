@@ -66,6 +66,11 @@ class ExpressionRules(Transformer):
 
     file: str
 
+    def _syntax_error(self, meta: Any, message: str) -> ModelicaSyntaxError:
+        """A syntax error at the parse-tree node ``meta`` of this file."""
+        line, col = node_pos(meta)
+        return ModelicaSyntaxError(self.file, line, col, message)
+
     # -- equations ---------------------------------------------------------------------------
     def equation(self, meta, ch):
         return ch[0]
@@ -75,10 +80,8 @@ class ExpressionRules(Transformer):
             return A.EqSimple(ch[0], ch[1], node_pos(meta))
         if isinstance(ch[0], A.Call):
             return A.EqCall(ch[0], node_pos(meta))
-        line, col = node_pos(meta)
-        raise ModelicaSyntaxError(self.file, line, col,
-                                  "an equation must be 'expression = expression' or a call "
-                                  "such as connect(a, b)")
+        raise self._syntax_error(meta, "an equation must be 'expression = expression' or a "
+                                      "call such as connect(a, b)")
 
     def if_equation(self, meta, ch):
         cond = ch[0]
@@ -211,10 +214,8 @@ class ExpressionRules(Transformer):
         return _Named((ident_text(ch[0]), ch[1]))
 
     def function_argument_partial(self, meta, ch):
-        line, col = node_pos(meta)
-        raise ModelicaSyntaxError(self.file, line, col,
-                                  "unsupported Modelica construct: functional arguments "
-                                  "('function f(...)' in a call)")
+        raise self._syntax_error(meta, "unsupported Modelica construct: functional arguments "
+                                      "('function f(...)' in a call)")
 
     def array(self, meta, ch):
         c = ch[0]
