@@ -108,11 +108,35 @@ int bgm_call_xdot(bgm_inst *c, double t, const double *x, double *xdot) {
     return bgm_call_model(c, F_XDOT, t, x, outs, sizes, 1);
 }
 
+/* d(xdot)/dx as a dense column-major nx x nx matrix. The generated function writes the
+   structural nonzeros (column-major order) to the front of jac; they are scattered in place
+   from the last one down: nonzero k goes to a position >= k, so none is overwritten before it
+   is read. CasADi's compressed pattern is {nrow, ncol, colind[ncol + 1], row[nnz]}, or
+   {nrow, ncol, 1} for a dense one (colind[0] is 0 otherwise). */
 int bgm_call_jacx(bgm_inst *c, double t, const double *x, double *jac) {
+    const casadi_int *sp = BGM_CAT(BGM_CASADI_JACX, _sparsity_out)(0);
+    const casadi_int nrow = sp[0], ncol = sp[1], *colind = sp + 2, *row = sp + 3 + ncol;
+    const int dense = nrow * ncol > 0 && sp[2] == 1;
     double *outs[1] = {jac};
-    const size_t sizes[1] = {(size_t)BGM_NX * BGM_NX};
+    size_t sizes[1];
+    size_t next = (size_t)nrow * (size_t)ncol, pos, q;
+    casadi_int j, k;
+    int rc;
+    sizes[0] = dense ? next : (size_t)colind[ncol];
     c->stat_jac++;
-    return bgm_call_model(c, F_JACX, t, x, outs, sizes, 1);
+    rc = bgm_call_model(c, F_JACX, t, x, outs, sizes, 1);
+    if (rc || dense) return rc;
+    for (j = ncol - 1; j >= 0; j--) {
+        for (k = colind[j + 1] - 1; k >= colind[j]; k--) {
+            double v = jac[k];
+            pos = (size_t)j * (size_t)nrow + (size_t)row[k];
+            for (q = pos + 1; q < next; q++) jac[q] = 0.0;
+            jac[pos] = v;
+            next = pos;
+        }
+    }
+    for (q = 0; q < next; q++) jac[q] = 0.0;
+    return 0;
 }
 
 /* ------------------------------------------------------------------------- logging */
