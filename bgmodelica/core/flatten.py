@@ -380,17 +380,10 @@ class _Flattener(ConnectionLowering):
         res = ca.SX(lhs - rhs)
         signs = alias_signs(shape_l, shape_r)
         if signs:
-            ratio = -signs[1] / signs[0]             # sa*a + sb*b = 0: a = ratio*b
-            var_of = self.var_of.get
-            add = self.equations.append
+            add, alias_of = self.equations.append, self._alias_of
             for k, (leaves, consts, where, _) in enumerate(members):
-                alias = None
-                if not any(consts):
-                    a, b = leaves
-                    ia, ib = var_of(id(a)), var_of(id(b))
-                    if ia is not None and ib is not None and ia != ib \
-                            and a.der_of is None and b.der_of is None:
-                        alias = (ia, ib, ratio)
+                alias = None if any(consts) else \
+                    alias_of(signs[0], leaves[0], signs[1], leaves[1])
                 add(FlatEquation(None, where, alias, at=(res, k)))
         else:
             self.equations.extend(FlatEquation(None, m[2], at=(res, k))
