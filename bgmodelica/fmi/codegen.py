@@ -131,6 +131,15 @@ def build_functions(spec: FmuSpec, prefix: str) -> ModelFunctions:
     return ModelFunctions(ode, fwd, jacx, xdot_only, init, initfwd, events)
 
 
+def jacobian_band(jacx: ca.Function) -> tuple[int, int]:
+    """``(kl, ku)``: the lower and upper bandwidth of the Jacobian's structural pattern (the
+    embedded solver's LU works inside ``kl`` rows below and ``kl + ku`` columns right of the
+    diagonal; a dense pattern gives ``(nx - 1, nx - 1)``)."""
+    rows, cols = jacx.sparsity_out(0).get_triplet()
+    offsets = [r - c for r, c in zip(rows, cols, strict=True)]
+    return max([0, *offsets]), max([0, *(-d for d in offsets)])
+
+
 def _pruned(f: ca.Function) -> ca.Function:
     """``f`` expanded to SX where possible: the generated code then evaluates only what its
     outputs need (the solver's xdot and Jacobian skip the outputs ``y``). Functions holding

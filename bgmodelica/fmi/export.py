@@ -65,7 +65,7 @@ def export_fmu(spec: FmuSpec, out_dir: str | Path, fmi_version: int = 2,
             (src / f"{model_base}.c").read_text(), _runtime_digest(),
             repr((spec.start_time, spec.stop_time, spec.step_size, spec.tolerance)))
         data = model_data_sources(spec, table, fmi_version, token, f"{model_base}.h", prefix,
-                                  interfaces)
+                                  interfaces, codegen.jacobian_band(funcs.jacx))
         for name, text in data.items():
             (src / name).write_text(text)
         sources = c_files(src)

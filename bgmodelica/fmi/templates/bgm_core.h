@@ -217,6 +217,7 @@ bgm_status bgm_event_indicators(bgm_inst *c, const char *fn, size_t ni);
 bgm_status bgm_do_step(bgm_inst *c, const char *fn, double t, double h);
 bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end);  /* bgm_solver.c */
 bgm_status bgm_sdirk_integrate(bgm_inst *c, const char *fn, double t_end); /* bgm_sdirk.c */
+void bgm_iteration_matrix(double *m, const double *J, double coef, int n); /* I - coef*J */
 int bgm_lu_factor(double *a, int *piv, int n);        /* row-major, partial pivoting */
 void bgm_lu_solve(const double *a, const int *piv, int n, double *b);
 double bgm_wnorm(const double *v, const double *sc, int n); /* RMS of v ./ sc */

@@ -93,8 +93,7 @@ bgm_status bgm_sdirk_integrate(bgm_inst *c, const char *fn, double t_end) {
         rc = bgm_call_jacx(c, t, x0, J);
         if (rc) goto eval_failed;
         /* M = I - hs*G*J ; J is column-major from CasADi, M row-major */
-        for (i = 0; i < n; i++)
-            for (j = 0; j < n; j++) M[i * n + j] = (i == j ? 1.0 : 0.0) - hs * G * J[i + j * n];
+        bgm_iteration_matrix(M, J, hs * G, n);
         if (bgm_lu_factor(M, c->piv, n)) {
             why = "singular iteration matrix";
             c->stat_newton_fail++;

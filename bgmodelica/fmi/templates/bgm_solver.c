@@ -60,52 +60,6 @@ size_t bgm_solver_workspace(void) {
     return 13 * n + 2 * n * n;
 }
 
-/* LU factorisation with partial pivoting of the row-major n x n matrix a (in place). */
-int bgm_lu_factor(double *a, int *piv, int n) {
-    int i, j, k;
-    for (k = 0; k < n; k++) {
-        int p = k;
-        double amax = fabs(a[k * n + k]);
-        for (i = k + 1; i < n; i++)
-            if (fabs(a[i * n + k]) > amax) {
-                amax = fabs(a[i * n + k]);
-                p = i;
-            }
-        piv[k] = p;
-        if (amax == 0.0 || !isfinite(amax)) return 1;
-        if (p != k)
-            for (j = 0; j < n; j++) {
-                double t = a[k * n + j];
-                a[k * n + j] = a[p * n + j];
-                a[p * n + j] = t;
-            }
-        for (i = k + 1; i < n; i++) {
-            double m = a[i * n + k] / a[k * n + k];
-            a[i * n + k] = m;
-            if (m != 0.0)
-                for (j = k + 1; j < n; j++) a[i * n + j] -= m * a[k * n + j];
-        }
-    }
-    return 0;
-}
-
-void bgm_lu_solve(const double *a, const int *piv, int n, double *b) {
-    int i, j;
-    for (i = 0; i < n; i++) {
-        double t;
-        if (piv[i] != i) {
-            t = b[i];
-            b[i] = b[piv[i]];
-            b[piv[i]] = t;
-        }
-        for (j = 0; j < i; j++) b[i] -= a[i * n + j] * b[j];
-    }
-    for (i = n - 1; i >= 0; i--) {
-        for (j = i + 1; j < n; j++) b[i] -= a[i * n + j] * b[j];
-        b[i] /= a[i * n + i];
-    }
-}
-
 /* root mean square of v ./ sc */
 double bgm_wnorm(const double *v, const double *sc, int n) {
     double s = 0.0;
@@ -329,9 +283,7 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
             double dy_old = 0.0;
             int k, fresh = b->jac_fresh;
             if (!c->lu_ok || c->lu_c != c_coef) {
-                for (i = 0; i < n; i++)
-                    for (j = 0; j < n; j++)
-                        LU[i * n + j] = (i == j ? 1.0 : 0.0) - c_coef * J[i + j * n];
+                bgm_iteration_matrix(LU, J, c_coef, n);
                 if (bgm_lu_factor(LU, c->piv, n)) {
                     c->lu_ok = 0;
                     why = "singular iteration matrix";
