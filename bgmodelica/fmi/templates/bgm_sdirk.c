@@ -5,7 +5,7 @@
  * its embedded order-3 solution for the local error estimate.  After new inputs (held over
  * the communication step, a jump in the right-hand side) a multistep method must restart at
  * order 1 with small steps; one SDIRK4 step of the communication step's length usually does.
- * All stages share the diagonal coefficient, so one dense LU factorisation of
+ * All stages share the diagonal coefficient, so one LU factorisation (bgm_lu.c) of
  * M = I - h*gamma*J per step serves every Newton iteration of every stage; J = d(xdot)/dx
  * comes from the CasADi-generated Jacobian once per step attempt (simplified Newton).  The
  * error estimate is filtered through M^{-1} (Shampine's trick) so that stiff components do not

@@ -7,9 +7,9 @@
  * kappa coefficients): the solution history is a table D of backward differences at spacing
  * h, re-expressed exactly for a new step size when h changes.  Each step predicts from D,
  * corrects with a simplified Newton iteration on (I - c J) with c = h / alpha[order] (one
- * dense LU reused over steps while it converges; J = d(xdot)/dx from the CasADi-generated
- * Jacobian, re-evaluated only when Newton stalls), and estimates the local error from the
- * corrector's update.  After order+1 steps at the same size the order and size change to
+ * LU inside the Jacobian's band, bgm_lu.c, reused over steps while it converges;
+ * J = d(xdot)/dx from the CasADi-generated Jacobian, re-evaluated only when Newton stalls),
+ * and estimates the local error from the corrector's update.  After order+1 steps at the same size the order and size change to
  * whichever of order-1, order, order+1 allows the largest step.
  *
  * Between DoStep calls the history is kept when nothing changed (time, states, inputs up to
