@@ -9,8 +9,9 @@
  * corrects with a simplified Newton iteration on (I - c J) with c = h / alpha[order] (one
  * LU inside the Jacobian's band, bgm_lu.c, reused over steps while it converges;
  * J = d(xdot)/dx from the CasADi-generated Jacobian, re-evaluated only when Newton stalls),
- * and estimates the local error from the corrector's update.  After order+1 steps at the same size the order and size change to
- * whichever of order-1, order, order+1 allows the largest step.
+ * and estimates the local error from the corrector's update.  After order+1 steps at the
+ * same size the order and size change to whichever of order-1, order, order+1 allows the
+ * largest step.
  *
  * Between DoStep calls the history is kept when nothing changed (time, states, inputs up to
  * rounding, parameters, tolerance): a step may then run past the communication point and the
