@@ -301,7 +301,9 @@ def compile_rows(sizes: list[int]) -> dict:
     by about 8 %, and a model is usually compiled in a new session."""
     out = subprocess.run([sys.executable, str(HERE / "compile_scaling.py"), "--json",
                           str(COMPILE_REPEAT), *map(str, sizes)],
-                         capture_output=True, text=True, check=True, cwd=HERE.parent)
+                         capture_output=True, text=True, cwd=HERE.parent)
+    if out.returncode:
+        raise RuntimeError(f"compile_scaling.py --json failed:\n{out.stderr[-3000:]}")
     rows = json.loads(out.stdout.strip().splitlines()[-1])
     for r in rows:
         print(f"  compile: {r['equations']} equations in {r['seconds']:.3f} s "
