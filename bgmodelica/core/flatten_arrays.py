@@ -29,22 +29,41 @@ def residual(eq: ArrayEquation, where: str, pos: dict[int, int], symbols: ca.SX,
     flattening) keeps the rows of each declared array for the next equation using it."""
     shape = eq.shape
     size = int(np.prod(shape))
-    found: list[bool] = []
+    lowering = _Lowering(eq, where, pos, symbols, alien, {} if memo is None else memo)
+    res = ca.SX(lowering.lower(eq.lhs, shape) - lowering.lower(eq.rhs, shape))
+    if not lowering.found:
+        raise EquationError(f"{where}: equation {eq!r} has no variables")
+    if res.numel() != size:
+        res = ca.repmat(res, size, 1)
+    return res, size
 
-    def lower(x: Any, want: tuple[int, ...]) -> Any:
+
+class _Lowering:
+    """One array equation's operands as SX columns. A class rather than a recursive closure:
+    a closure that calls itself is a reference cycle, which would keep the flattener it
+    reports through (and every symbol entry it holds) alive until the cyclic collector runs."""
+
+    def __init__(self, eq: ArrayEquation, where: str, pos: dict[int, int], symbols: ca.SX,
+                 alien: Alien, memo: dict[int, Any]) -> None:
+        self.eq, self.where, self.pos, self.symbols = eq, where, pos, symbols
+        self.alien, self.memo = alien, memo
+        self.found = False
+
+    def lower(self, x: Any, want: tuple[int, ...]) -> Any:
+        pos = self.pos
         if isinstance(x, ArrayExpr):
             if x.node is None:
                 try:
-                    idx = _rows(x.items, pos, {} if memo is None else memo)
+                    idx = _rows(x.items, pos, self.memo)
                 except KeyError:
                     items = x.items.ravel()
                     sym = next(leaf.sym for leaf in items if id(leaf.sym) not in pos)
-                    raise alien(sym, eq, where) from None
-                found.append(True)
-                col = symbols[idx]
+                    raise self.alien(sym, self.eq, self.where) from None
+                self.found = True
+                col = self.symbols[idx]
             else:
                 op, args = x.node
-                col = apply_op(op, [lower(a, x.shape) for a in args])
+                col = apply_op(op, [self.lower(a, x.shape) for a in args])
             return _broadcast(col, x.shape, want)
         if isinstance(x, np.ndarray):
             return ca.DM(np.broadcast_to(x.astype(float), want).ravel())
@@ -53,17 +72,10 @@ def residual(eq: ArrayEquation, where: str, pos: dict[int, int], symbols: ca.SX,
             shape_of(x, leaves, [])
             for sym in leaves:
                 if id(sym) not in pos:
-                    raise alien(sym, eq, where)
-            found.extend(True for _ in leaves[:1])
+                    raise self.alien(sym, self.eq, self.where)
+            self.found = self.found or bool(leaves)
             return to_sx(x)
         return float(x)
-
-    res = ca.SX(lower(eq.lhs, shape) - lower(eq.rhs, shape))
-    if not found:
-        raise EquationError(f"{where}: equation {eq!r} has no variables")
-    if res.numel() != size:
-        res = ca.repmat(res, size, 1)
-    return res, size
 
 
 def _rows(items: np.ndarray, pos: dict[int, int], memo: dict[int, Any]) -> list[int]:
