@@ -44,3 +44,34 @@ def test_a_paused_collector_stays_paused():
         assert not gc.isenabled()
     finally:
         gc.enable()
+
+
+def test_flattening_an_array_model_leaves_no_cycles_behind():
+    """The flattener and its per-symbol entries are freed by reference counting: before, a
+    recursive closure of the array lowering kept them in a cycle (about 5 objects per array
+    element for the cyclic collector to find)."""
+    from bgmodelica.core.flatten import flatten
+    from library.examples.circuits import RCLadderVector
+
+    model = RCLadderVector(2000)
+    gc.collect()
+    gc.disable()
+    try:
+        flat = flatten(model)
+        found = gc.collect()
+    finally:
+        gc.enable()
+    assert len(flat.equations) == 4000
+    assert found < 500
+
+
+def test_compiled_objects_skip_the_young_generations():
+    """After compile the young generations hold nothing of the compiled model: the first
+    collections afterwards do not scan its objects."""
+    import bgmodelica as bg
+
+    gc.collect()
+    compiled = bg.compile(RCLadder(300))
+    assert gc.isenabled()
+    young = len(gc.get_objects(generation=0)) + len(gc.get_objects(generation=1))
+    assert young < 1000 < len(compiled.flat.variables)
