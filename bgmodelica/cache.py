@@ -341,8 +341,24 @@ def drop(folder: Path, key: str, compile_seconds: float, load_seconds: float) ->
     _entry(folder, key).unlink(missing_ok=True)
 
 
+def _compact_rows(compiled: Any) -> None:
+    """Point the symbols of the flat models at rows of their models' own columns: flattening
+    left them rows of one vector of every symbol of the tree, aliases eliminated since
+    included, which would otherwise be stored whole (about half the symbols of a network)."""
+    models = {id(m): m for m in (compiled.flat, compiled.reduced.model, compiled.sorted.model)}
+    for model in models.values():
+        for items, stacked in ((model.variables, model.stacked_variables),
+                               (model.parameters, model.stacked_parameters)):
+            if any(v.at is not None for v in items):
+                column = stacked()
+                for k, v in enumerate(items):
+                    if v.at is not None:
+                        v.at = (column, k)
+
+
 def store(compiled: Any, folder: Path, key: str) -> Path | None:
     """Write ``compiled`` under ``key``; None (and nothing written) if it cannot be."""
+    _compact_rows(compiled)
     source, cache = compiled.source, compiled.dae.cache
     compiled.source, compiled.dae.cache = None, {}
     try:

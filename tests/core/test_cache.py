@@ -33,6 +33,24 @@ def test_second_compile_is_a_load_with_identical_results(tmp_path):
     assert second.summary()["states"] == first.summary()["states"]
 
 
+def test_an_entry_holds_the_model_symbols_not_the_whole_tree(tmp_path):
+    """Eliminated alias variables are not stored: the flat models' symbols are rows of the
+    models' own columns, not of flattening's vector of every symbol of the tree."""
+    from library.examples import RCLadder
+
+    first = bg.compile(RCLadder(40), cache=tmp_path)
+    assert len(first.flat.aliases) > 100
+    second = bg.compile(RCLadder(40), cache=tmp_path)
+    assert set(second.timings) == {"cache_load"}
+    for model in (second.flat, second.reduced.model):
+        for items in (model.variables, model.parameters):
+            rows = {v.at[0].numel() for v in items if v.at is not None}
+            assert rows <= {len(items)}
+    a = bg.simulate(first, stop_time=0.2, interval=0.02)
+    b = bg.simulate(second, stop_time=0.2, interval=0.02)
+    assert all(np.array_equal(a[n], b[n]) for n in a.names)
+
+
 def test_parameter_values_come_from_the_model_not_the_entry(tmp_path):
     bg.compile(RC(), cache=tmp_path)
     hit = bg.compile(RC(**{"resistor.R": 500.0}), cache=tmp_path)    # tau = 0.5 s
