@@ -10,23 +10,28 @@ from itertools import chain
 
 import numpy as np
 
+#: :func:`gc_paused` promotes only after this many new tracked objects (a large model)
+PROMOTE_FROM = 50_000
+
 
 @contextmanager
 def gc_paused(promote: bool = False) -> Iterator[None]:
     """Pause the cyclic garbage collector (the graph algorithms allocate many small acyclic
     lists, which makes it trigger often for nothing). Usable as a decorator.
 
-    promote: on leaving, move every tracked object straight to the oldest generation (a
-    compilation's millions of objects live as long as the compiled model: the collector
-    would otherwise scan them all once in each younger generation first, about 0.1 us per
-    object). Cyclic garbage made before then waits for the next full collection."""
+    promote: on leaving, if at least :data:`PROMOTE_FROM` new objects are tracked, move every
+    tracked object straight to the oldest generation. A large model's millions of objects
+    live as long as the model: the collector would otherwise scan them all once in each
+    younger generation first (about 0.1 us per object). Cyclic garbage made before then
+    waits for the next full collection, hence the threshold: small models, built often,
+    change nothing."""
     enabled = gc.isenabled()
     gc.disable()
     try:
         yield
     finally:
         if enabled:
-            if promote:
+            if promote and gc.get_count()[0] >= PROMOTE_FROM:
                 gc.freeze()
                 gc.unfreeze()
             gc.enable()

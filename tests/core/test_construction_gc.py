@@ -65,13 +65,22 @@ def test_flattening_an_array_model_leaves_no_cycles_behind():
     assert found < 500
 
 
-def test_compiled_objects_skip_the_young_generations():
-    """After compile the young generations hold nothing of the compiled model: the first
-    collections afterwards do not scan its objects."""
+def _young() -> int:
+    return len(gc.get_objects(generation=0)) + len(gc.get_objects(generation=1))
+
+
+def test_a_large_model_skips_the_young_generations():
+    """After building and after compiling a large model the young generations hold nothing
+    of it: the first collections afterwards do not scan its objects. A small model is left
+    to the collector as usual (see graph.PROMOTE_FROM)."""
     import bgmodelica as bg
 
     gc.collect()
-    compiled = bg.compile(RCLadder(300))
+    model = RCLadder(1500)
+    assert _young() < 1000
+    compiled = bg.compile(model)
     assert gc.isenabled()
-    young = len(gc.get_objects(generation=0)) + len(gc.get_objects(generation=1))
-    assert young < 1000 < len(compiled.flat.variables)
+    assert _young() < 1000 < len(compiled.flat.variables)
+    gc.collect()
+    small = bg.compile(RCLadder(20))
+    assert _young() > len(small.flat.variables)
