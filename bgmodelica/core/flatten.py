@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import ConnectError, DeclarationError, EquationError
 from ..validate import check_binding, check_sx_binding, guarded_equations
 from . import flatten_arrays, flatten_hybrid
-from .arrays import ArrayEquation
+from .arrays import ArrayEquation, ComponentArray
 from .component import Component, Connection, Connector, Element
 from .expr import (
     HYBRID_NODES,
@@ -34,6 +34,7 @@ from .expr import (
 )
 from .flatmodel import EquationSources, FlatEquation, FlatModel, FlatVariable, take
 from .flatten_connections import ConnectionLowering
+from .flatten_vectorized import array_equations
 from .variables import (
     KIND_INPUT,
     KIND_PARAMETER,
@@ -78,6 +79,7 @@ class _Flattener(ConnectionLowering):
         stack: list[tuple[Element, str, Element | None]] = [(self.top, "", None)]
         paths, parents, elements = self.paths, self.parents, self.elements
         connections, pending = self.connections, self.pending
+        vectorized: set[int] = set()          # elements whose equations an array wrote
         while stack:
             elem, path, parent = stack.pop()
             key = id(elem)
@@ -90,11 +92,14 @@ class _Flattener(ConnectionLowering):
                 parents[key] = parent
             elements.append(elem)
             if isinstance(elem, Component):
-                for eq in guarded_equations(elem, self.where(elem), path, blocks=True):
-                    if isinstance(eq, Connection):
-                        connections.append((eq, elem))
-                    else:
-                        pending.append((eq, elem))
+                if key not in vectorized:
+                    for eq in guarded_equations(elem, self.where(elem), path, blocks=True):
+                        if isinstance(eq, Connection):
+                            connections.append((eq, elem))
+                        else:
+                            pending.append((eq, elem))
+                if "_arrays" in elem.__dict__:
+                    self._array_equations(elem, path, vectorized)
             children = elem._children
             if children:
                 prefix = f"{path}." if path else ""
@@ -121,6 +126,22 @@ class _Flattener(ConnectionLowering):
         flat.remember_stacked(ca.vertcat(*self.columns) if self.columns else None,
                               *[take(self.all_sx, self._rows(entries)) for entries in self.entries])
         return flat
+
+    def _array_equations(self, elem: Component, path: str, vectorized: set[int]) -> None:
+        """Equations of ``elem``'s arrays of components written once per array where exact
+        (:mod:`.flatten_vectorized`); those elements are then not asked for theirs."""
+        prefix = f"{path}." if path else ""
+        for name in elem.__dict__["_arrays"]:
+            arr = elem.__dict__.get(name)
+            if not isinstance(arr, ComponentArray):
+                continue
+            eqs = array_equations(arr)
+            if eqs is None:
+                continue
+            self.origins[id(arr)] = \
+                f"{prefix}{name}[1..{len(arr)}] ({type(arr.elements[0]).__name__} array)"
+            self.pending.extend((eq, arr) for eq in eqs)
+            vectorized.update(id(item) for item in arr.elements)
 
     def _initial_equations(self) -> list[FlatEquation]:
         """Lower the components' ``initial_equations()`` (Modelica ``initial equation``) to

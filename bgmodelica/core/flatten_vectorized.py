@@ -1,0 +1,125 @@
+"""The equations of an array of components written once for the whole array.
+
+``array_of(Resistor, n)`` gives ``n`` components of one class. Their ``equations()`` are the
+same code, so instead of running it ``n`` times (``n`` scalar equations of each kind, each
+walked and grouped by flattening), it runs once on a view of the array in which every variable
+and parameter is the :class:`~.arrays.ArrayExpr` of the elements' scalars and every connector
+a view of the elements' connectors. ``v == R*i`` then comes out as one array equation,
+lowered as a block like a hand-written one (:mod:`.flatten_arrays`): the same scalar equations
+in fewer, larger CasADi operations.
+
+Only what the view can answer exactly is taken: the elements must be leaf components (no
+subcomponents, no added equations) of one class with the same declarations, and every
+attribute the equations read must be a variable, a parameter, a connector, a method or
+property of the class, or a plain value equal in every element. Anything else (a value that
+differs between elements, an ``if`` on a variable, an event, a ``connect``) makes
+:func:`array_equations` answer None and the elements are flattened one by one, as before.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .arrays import ArrayEquation, ArrayExpr, ComponentArray
+from .component import Component, Connector, _own_methods
+from .expr import Leaf
+
+#: plain attribute values a view hands out when every element has the same one
+_PLAIN = (bool, int, float, str, type(None))
+
+
+class _Varies(Exception):
+    """The elements differ in something the equations read: flatten them one by one."""
+
+
+class _View:
+    """Elements of one class seen as one: attributes are arrays of the elements' ones."""
+
+    __slots__ = ("_items",)
+
+    def __init__(self, items: list[Any]) -> None:
+        object.__setattr__(self, "_items", items)
+
+    def __getattr__(self, name: str) -> Any:
+        items = self._items
+        owner = getattr(type(items[0]), name, None)
+        if isinstance(owner, property) and owner.fget is not None:
+            return owner.fget(self)
+        if callable(owner) and not isinstance(owner, type) and name not in vars(items[0]):
+            return owner.__get__(self)          # a method, bound to the view
+        try:
+            values = [item.__dict__[name] for item in items]
+        except KeyError:
+            raise _Varies(name) from None
+        first = values[0]
+        if isinstance(first, Leaf):
+            if not all(isinstance(v, Leaf) for v in values):
+                raise _Varies(name)
+            arr = np.empty(len(values), dtype=object)
+            arr[:] = values
+            return ArrayExpr(arr)
+        if isinstance(first, Connector):
+            return _View(values)
+        if isinstance(first, _PLAIN) and all(type(v) is type(first) and v == first
+                                             for v in values):
+            return first
+        raise _Varies(name)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise _Varies(name)
+
+    @property
+    def __class__(self) -> type:           # isinstance(self, ...) as for an element
+        return type(self._items[0])
+
+    def __bool__(self) -> bool:
+        raise _Varies("truth value")
+
+
+def array_equations(arr: ComponentArray) -> list[ArrayEquation] | None:
+    """The equations of the components of ``arr`` as array equations (one per equation of
+    the class, over all elements), or None when they cannot be written that way."""
+    items = arr.elements
+    if len(items) < 2 or not _uniform(items):
+        return None
+    view = _View(items)
+    out: list[ArrayEquation] = []
+    try:
+        for own in _own_methods(type(items[0]), "equations"):
+            result = own(view)
+            if result is None:
+                continue
+            for eq in result:
+                if not (isinstance(eq, ArrayEquation) and eq.is_block()
+                        and eq.shape == (len(items),)):
+                    return None
+                out.append(eq)
+    except Exception:  # noqa: BLE001 -- anything the view cannot answer: one by one instead
+        return None
+    return out
+
+
+def _uniform(items: list[Any]) -> bool:
+    """Leaf components of one class with the same declarations and connectors, no equations
+    or arrays added to an instance."""
+    first = items[0]
+    cls = type(first)
+    if not isinstance(first, Component):
+        return False
+    symbols = first._symbols.keys()
+    children = first._children
+    if any(not isinstance(c, Connector) or c._children or "_arrays" in c.__dict__
+           for c in children.values()):
+        return False
+    connector_symbols = {k: c._symbols.keys() for k, c in children.items()}
+    for item in items:
+        if type(item) is not cls or item._equations or "_arrays" in item.__dict__ \
+                or item._symbols.keys() != symbols or item._children.keys() != children.keys():
+            return False
+        for k, c in item._children.items():
+            if type(c) is not type(children[k]) or c._children or "_arrays" in c.__dict__ \
+                    or c._symbols.keys() != connector_symbols[k]:
+                return False
+    return True

@@ -1,0 +1,124 @@
+"""Arrays of components: their equations written once for the whole array (one array
+equation per equation of the class) where that is exact, element by element otherwise."""
+
+from __future__ import annotations
+
+import math
+
+import casadi as ca
+import numpy as np
+
+import bgmodelica as bg
+from bgmodelica import Component, Parameter, Variable, array_of, der, time
+from bgmodelica.core.flatten import flatten
+from bgmodelica.core.variables import TIME
+from library.examples import RCLadder, RCLadderArrays
+
+TIGHT = {"rtol": 1e-10, "atol": 1e-12}
+
+
+def origins(model: Component) -> set[str]:
+    return {eq.origin for eq in flatten(model).equations}
+
+
+def test_library_component_arrays_are_written_once():
+    got = origins(RCLadderArrays(6))
+    assert {"R[1..6] (Resistor array)", "C[1..6] (Capacitor array)"} <= got
+    assert not any(o.startswith(("R[3] (", "C[3] (")) for o in got)
+
+
+def test_same_scalar_equations_as_element_by_element(monkeypatch):
+    """The flat model of the array form has the same variables and, equation by equation,
+    the same residuals (compared numerically at a random point) as without vectorizing."""
+    from bgmodelica.core import flatten as flatten_module
+
+    fast = flatten(RCLadderArrays(5))
+    monkeypatch.setattr(flatten_module, "array_equations", lambda arr: None)
+    slow = flatten(RCLadderArrays(5))
+    assert [v.name for v in fast.variables] == [v.name for v in slow.variables]
+    assert len(fast.equations) == len(slow.equations)
+    rng = np.random.default_rng(1)
+    values: dict[str, float] = {}
+
+    def residuals(flat) -> list[float]:
+        syms = [v.sx for v in flat.variables] + [p.sx for p in flat.parameters]
+        names = [v.name for v in flat.variables] + [p.name for p in flat.parameters]
+        vals = [values.setdefault(n, float(rng.normal())) for n in names]
+        f = ca.Function("r", [ca.vertcat(*syms), TIME.sx], [flat.stacked_residuals()])
+        return sorted(np.round(np.asarray(f(vals, 0.3)).ravel(), 12).tolist())
+
+    assert residuals(fast) == residuals(slow)
+
+
+def test_results_equal_the_component_per_section_ladder():
+    a = bg.simulate(RCLadderArrays(7), stop_time=0.3, interval=0.03, **TIGHT)
+    b = bg.simulate(RCLadder(7), stop_time=0.3, interval=0.03, **TIGHT)
+    for k in (1, 4, 7):
+        assert np.max(np.abs(a[f"C[{k}].v"] - b[f"C{k}.v"])) < 1e-12
+        assert np.max(np.abs(a[f"R[{k}].i"] - b[f"R{k}.i"])) < 1e-9
+
+
+class Scaled(Component):
+    """y = gain * time, with ``gain`` a plain Python attribute set per instance."""
+
+    y = Variable()
+
+    def __init__(self, gain: float = 1.0, **modifiers):
+        self.gain = gain
+        super().__init__(**modifiers)
+
+    def equations(self):
+        yield self.y == self.gain * time
+
+
+class Switched(Component):
+    """A Python ``if`` on a plain attribute picks the equation."""
+
+    x = Variable(start=1.0, fixed=True)
+    k = Parameter(2.0)
+
+    def __init__(self, decay: bool = True, **modifiers):
+        self.decay = decay
+        super().__init__(**modifiers)
+
+    def equations(self):
+        if self.decay:
+            yield der(self.x) == -self.k * self.x
+        else:
+            yield der(self.x) == self.k
+
+
+class Bank(Component):
+    def __init__(self, gains, decays):
+        super().__init__()
+        self.s = array_of(Scaled, len(gains), gain=list(gains))
+        self.w = array_of(Switched, len(decays), decay=list(decays))
+
+
+def test_a_plain_attribute_that_differs_falls_back_to_element_by_element():
+    model = Bank([1.0, -2.0, 3.0], [True, False, True])
+    got = origins(Bank([1.0, -2.0, 3.0], [True, False, True]))
+    assert "s[2] (Scaled)" in got and "w[2] (Switched)" in got
+    res = bg.simulate(model, stop_time=1.0, interval=0.5, **TIGHT)
+    assert np.allclose(res["s[2].y"], -2.0 * res.time)
+    assert math.isclose(res["w[1].x"][-1], math.exp(-2.0), rel_tol=1e-8)
+    assert math.isclose(res["w[2].x"][-1], 3.0, rel_tol=1e-8)
+
+
+def test_a_plain_attribute_equal_in_every_element_is_used_as_is():
+    got = origins(Bank([2.0, 2.0], [False, False, False]))
+    assert {"s[1..2] (Scaled array)", "w[1..3] (Switched array)"} <= got
+    res = bg.simulate(Bank([2.0, 2.0], [False, False, False]), stop_time=1.0, interval=0.5,
+                      **TIGHT)
+    assert np.allclose(res["s[2].y"], 2.0 * res.time)
+    assert math.isclose(res["w[3].x"][-1], 3.0, rel_tol=1e-8)
+
+
+def test_an_element_with_an_added_equation_is_not_vectorized():
+    model = Bank([1.0, 1.0], [True, True])
+    model.s[0].declare("z", Variable())
+    model.s[0].equation(model.s[0].z == 5.0)
+    got = origins(model)
+    assert "s[1] (Scaled)" in got and "w[1..2] (Switched array)" in got
+    res = bg.simulate(model, stop_time=0.5, interval=0.5, **TIGHT)
+    assert res["s[1].z"][-1] == 5.0
