@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import ConnectError, DeclarationError, EquationError
 from ..validate import check_binding, check_sx_binding, guarded_equations
 from . import flatten_arrays, flatten_hybrid
-from .arrays import ArrayEquation, ComponentArray
+from .arrays import ArrayEquation
 from .component import Component, Connection, Connector, Element
 from .expr import (
     HYBRID_NODES,
@@ -34,7 +34,7 @@ from .expr import (
 )
 from .flatmodel import EquationSources, FlatEquation, FlatModel, FlatVariable, take
 from .flatten_connections import ConnectionLowering
-from .flatten_vectorized import array_equations
+from .flatten_vectorized import array_children, array_equations
 from .variables import (
     KIND_INPUT,
     KIND_PARAMETER,
@@ -73,6 +73,7 @@ class _Flattener(ConnectionLowering):
         self.blocks: list[tuple[ArrayEquation, str]] = []   # array equations lowered whole
         self.initial_sources: list[tuple[Equation, str]] = []   # initial equations as written
         self.array_rows: dict[int, Any] = {}      # declared arrays' rows (flatten_arrays)
+        self.arrays: list[list[Component]] = []   # arrays of components written once
 
     # -- tree walk -------------------------------------------------------------------------
     def run(self, name: str) -> FlatModel:
@@ -91,6 +92,7 @@ class _Flattener(ConnectionLowering):
             if parent is not None:
                 parents[key] = parent
             elements.append(elem)
+            children = elem._children
             if isinstance(elem, Component):
                 if key not in vectorized:
                     for eq in guarded_equations(elem, self.where(elem), path, blocks=True):
@@ -98,9 +100,8 @@ class _Flattener(ConnectionLowering):
                             connections.append((eq, elem))
                         else:
                             pending.append((eq, elem))
-                if "_arrays" in elem.__dict__:
+                if children:
                     self._array_equations(elem, path, vectorized)
-            children = elem._children
             if children:
                 prefix = f"{path}." if path else ""
                 stack.extend((child, prefix + child_name, elem)
@@ -128,20 +129,19 @@ class _Flattener(ConnectionLowering):
         return flat
 
     def _array_equations(self, elem: Component, path: str, vectorized: set[int]) -> None:
-        """Equations of ``elem``'s arrays of components written once per array where exact
-        (:mod:`.flatten_vectorized`); those elements are then not asked for theirs."""
-        prefix = f"{path}." if path else ""
-        for name in elem.__dict__["_arrays"]:
-            arr = elem.__dict__.get(name)
-            if not isinstance(arr, ComponentArray):
-                continue
-            eqs = array_equations(arr)
+        """Equations of ``elem``'s arrays of components (children ``name[1]`` ..) written
+        once per array where exact (:mod:`.flatten_vectorized`); those elements are then
+        not asked for theirs."""
+        for base, items in array_children(elem._children).items():
+            eqs = array_equations(items)
             if eqs is None:
                 continue
-            self.origins[id(arr)] = \
-                f"{prefix}{name}[1..{len(arr)}] ({type(arr.elements[0]).__name__} array)"
-            self.pending.extend((eq, arr) for eq in eqs)
-            vectorized.update(id(item) for item in arr.elements)
+            where = f"{path}.{base}" if path else base
+            self.origins[id(items)] = \
+                f"{where}[1..{len(items)}] ({type(items[0]).__name__} array)"
+            self.pending.extend((eq, items) for eq in eqs)    # type: ignore[misc]
+            self.arrays.append(items)              # keeps id(items) unique while flattening
+            vectorized.update(id(item) for item in items)
 
     def _initial_equations(self) -> list[FlatEquation]:
         """Lower the components' ``initial_equations()`` (Modelica ``initial equation``) to

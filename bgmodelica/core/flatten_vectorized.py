@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from .arrays import ArrayEquation, ArrayExpr, ComponentArray
+from .arrays import ArrayEquation, ArrayExpr
 from .component import Component, Connector, _own_methods
 from .expr import Leaf
 
@@ -78,10 +78,21 @@ class _View:
         raise _Varies("truth value")
 
 
-def array_equations(arr: ComponentArray) -> list[ArrayEquation] | None:
-    """The equations of the components of ``arr`` as array equations (one per equation of
-    the class, over all elements), or None when they cannot be written that way."""
-    items = arr.elements
+def array_children(children: dict[str, Any]) -> dict[str, list[Any]]:
+    """Components named ``name[1]``, ``name[2]``... among ``children`` (as ``array_of`` and
+    Modelica arrays of components make them), by ``name``; two or more each."""
+    groups: dict[str, list[Any]] = {}
+    for key, child in children.items():
+        if key[-1] == "]" and isinstance(child, Component):
+            base, _, index = key[:-1].partition("[")
+            if index.isdigit():
+                groups.setdefault(base, []).append(child)
+    return {base: items for base, items in groups.items() if len(items) > 1}
+
+
+def array_equations(items: list[Any]) -> list[ArrayEquation] | None:
+    """The equations of the components ``items`` as array equations (one per equation of
+    their class, over all of them), or None when they cannot be written that way."""
     if len(items) < 2 or not _uniform(items):
         return None
     view = _View(items)

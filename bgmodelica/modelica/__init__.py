@@ -32,6 +32,7 @@ __all__ = ["load_modelica", "load_modelica_text", "export_modelica", "experiment
 
 def _load(stored: Any, name: str | None, kwargs: dict[str, Any]):
     from ..errors import ModelError
+    from ..structure.graph import gc_paused
     from . import builder as B
     from .scope import FileScope
 
@@ -47,7 +48,8 @@ def _load(stored: Any, name: str | None, kwargs: dict[str, Any]):
     if view.kind not in ("model", "block", "class"):
         raise ModelicaError(f"{stored.file}: {name} is a {view.kind}, not a model")
     try:
-        model = B.instantiate(view, B.top_mods(kwargs), None, "", scope, scope.cdef.pos)
+        with gc_paused(promote=True):          # as a Python model's constructor does
+            model = B.instantiate(view, B.top_mods(kwargs), None, "", scope, scope.cdef.pos)
     except RecursionError:
         raise ModelicaError(f"{stored.file}: {name}: the class hierarchy is too deep or "
                             "recursive") from None
