@@ -18,6 +18,8 @@ differs between elements, an ``if`` on a variable, an event, a ``connect``) make
 
 from __future__ import annotations
 
+import inspect
+from types import FunctionType, MethodType
 from typing import Any
 
 import numpy as np
@@ -44,11 +46,17 @@ class _View:
 
     def __getattr__(self, name: str) -> Any:
         items = self._items
-        owner = getattr(type(items[0]), name, None)
-        if isinstance(owner, property) and owner.fget is not None:
-            return owner.fget(self)
-        if callable(owner) and not isinstance(owner, type) and name not in vars(items[0]):
-            return owner.__get__(self)          # a method, bound to the view
+        cls = type(items[0])
+        owner = inspect.getattr_static(cls, name, None)
+        if name not in items[0].__dict__:
+            if isinstance(owner, property) and owner.fget is not None:
+                return owner.fget(self)
+            if isinstance(owner, staticmethod):
+                return owner.__func__
+            if isinstance(owner, classmethod):
+                return owner.__get__(None, cls)
+            if isinstance(owner, FunctionType):
+                return MethodType(owner, self)      # a method, bound to the view
         try:
             values = [item.__dict__[name] for item in items]
         except KeyError:

@@ -88,6 +88,27 @@ class Switched(Component):
             yield der(self.x) == self.k
 
 
+class Helped(Component):
+    """Equations built by a method, a static method and a property of the class."""
+
+    x = Variable(start=1.0, fixed=True)
+    a = Parameter(0.5)
+
+    @staticmethod
+    def twice(e):
+        return 2.0 * e
+
+    @property
+    def rate(self):
+        return self.twice(self.a)
+
+    def rhs(self):
+        return -self.rate * self.x
+
+    def equations(self):
+        yield der(self.x) == self.rhs()
+
+
 class Bank(Component):
     def __init__(self, gains, decays):
         super().__init__()
@@ -122,3 +143,16 @@ def test_an_element_with_an_added_equation_is_not_vectorized():
     assert "s[1] (Scaled)" in got and "w[1..2] (Switched array)" in got
     res = bg.simulate(model, stop_time=0.5, interval=0.5, **TIGHT)
     assert res["s[1].z"][-1] == 5.0
+
+
+class Helpers(Component):
+    def __init__(self, n=3):
+        super().__init__()
+        self.h = array_of(Helped, n, a=[0.5, 1.0, 1.5])
+
+
+def test_methods_static_methods_and_properties_work_on_the_array():
+    assert "h[1..3] (Helped array)" in origins(Helpers())
+    res = bg.simulate(Helpers(), stop_time=1.0, interval=0.5, **TIGHT)
+    for k, a in enumerate((0.5, 1.0, 1.5), start=1):
+        assert math.isclose(res[f"h[{k}].x"][-1], math.exp(-2.0 * a), rel_tol=1e-8)
