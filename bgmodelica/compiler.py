@@ -142,7 +142,7 @@ def compile(model: Component, *, select: Selector | None = None,  # noqa: A001
     The cyclic garbage collector is paused meanwhile: compilation allocates millions of
     objects that live until the end, and rescanning them costs more than it frees."""
     if cache is False or cache is None or select is not None:
-        with gc_paused(promote=True):
+        with gc_paused():
             return _compile(model, select, units)
     return _compile_cached(model, units, cache)
 
@@ -163,7 +163,7 @@ def _compile_cached(model: Component, units: str, cache: bool | str | Path) -> C
             key = None
     skip = key is not None and disk.skipped(folder, key)
     if key is not None and not skip:
-        with gc_paused(promote=True):
+        with gc_paused():
             hit = disk.load(folder, key, model, order)
         if hit is not None:
             built = sum(v for k, v in hit.timings.items() if k != "cache_store")
@@ -172,7 +172,7 @@ def _compile_cached(model: Component, units: str, cache: bool | str | Path) -> C
                 disk.drop(folder, key, built, hit.timings["cache_load"])
             return hit
     keyed = _time.perf_counter()
-    with gc_paused(promote=True):
+    with gc_paused():
         compiled = _compile(model, None, units)
     if skip:
         compiled.timings["cache_skipped"] = keyed - t0

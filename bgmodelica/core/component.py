@@ -57,15 +57,12 @@ from .variables import (
 def _gc_paused_init(init: Callable[..., None]) -> Callable[..., None]:
     """``init`` with the cyclic garbage collector paused until the outermost constructor
     returns: building a model allocates many long-lived objects and few cycles, and the
-    collector's rescans of them cost 30-50 % of the construction of a large model. They then
-    go straight to the oldest generation (see :func:`~bgmodelica.structure.graph.gc_paused`):
-    the first young collection would otherwise scan them all (0.13 s after 10,000 RC
-    sections)."""
+    collector's rescans of them cost 30-50 % of the construction of a large model."""
     @functools.wraps(init)
     def paused(self: Any, *args: Any, **kwargs: Any) -> None:
         if not gc.isenabled():
             return init(self, *args, **kwargs)
-        with gc_paused(promote=True):
+        with gc_paused():
             return init(self, *args, **kwargs)
     return paused
 

@@ -48,7 +48,7 @@ def _load(stored: Any, name: str | None, kwargs: dict[str, Any]):
     if view.kind not in ("model", "block", "class"):
         raise ModelicaError(f"{stored.file}: {name} is a {view.kind}, not a model")
     try:
-        with gc_paused(promote=True):          # as a Python model's constructor does
+        with gc_paused():                      # as a Python model's constructor is
             model = B.instantiate(view, B.top_mods(kwargs), None, "", scope, scope.cdef.pos)
     except RecursionError:
         raise ModelicaError(f"{stored.file}: {name}: the class hierarchy is too deep or "

@@ -10,30 +10,23 @@ from itertools import chain
 
 import numpy as np
 
-#: :func:`gc_paused` promotes only after this many new tracked objects (a large model)
-PROMOTE_FROM = 50_000
-
 
 @contextmanager
-def gc_paused(promote: bool = False) -> Iterator[None]:
+def gc_paused() -> Iterator[None]:
     """Pause the cyclic garbage collector (the graph algorithms allocate many small acyclic
     lists, which makes it trigger often for nothing). Usable as a decorator.
 
-    promote: on leaving, if at least :data:`PROMOTE_FROM` new objects are tracked, move every
-    tracked object straight to the oldest generation. A large model's millions of objects
-    live as long as the model: the collector would otherwise scan them all once in each
-    younger generation first (about 0.1 us per object). Cyclic garbage made before then
-    waits for the next full collection, hence the threshold: small models, built often,
-    change nothing."""
+    The objects made meanwhile are left to the collector's usual policy afterwards. Moving
+    them straight to the oldest generation (``gc.freeze(); gc.unfreeze()``) would save two
+    scans of them, but it hides them from the count that triggers full collections: a model
+    tree is cyclic (symbols and their owners), and models built and dropped in a loop then
+    piled up uncollected."""
     enabled = gc.isenabled()
     gc.disable()
     try:
         yield
     finally:
         if enabled:
-            if promote and gc.get_count()[0] >= PROMOTE_FROM:
-                gc.freeze()
-                gc.unfreeze()
             gc.enable()
 
 
