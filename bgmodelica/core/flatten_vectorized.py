@@ -57,6 +57,8 @@ class _View:
                 return owner.__get__(None, cls)
             if isinstance(owner, FunctionType):
                 return MethodType(owner, self)      # a method, bound to the view
+            if isinstance(owner, _PLAIN):
+                return owner                        # a class constant
         try:
             values = [item.__dict__[name] for item in items]
         except KeyError:

@@ -93,17 +93,18 @@ class Helped(Component):
 
     x = Variable(start=1.0, fixed=True)
     a = Parameter(0.5)
+    FACTOR = 2.0
 
     @staticmethod
     def twice(e):
-        return 2.0 * e
+        return Helped.FACTOR * e
 
     @property
     def rate(self):
         return self.twice(self.a)
 
     def rhs(self):
-        return -self.rate * self.x
+        return -self.rate * self.x * self.FACTOR / 2.0
 
     def equations(self):
         yield der(self.x) == self.rhs()
@@ -151,7 +152,7 @@ class Helpers(Component):
         self.h = array_of(Helped, n, a=[0.5, 1.0, 1.5])
 
 
-def test_methods_static_methods_and_properties_work_on_the_array():
+def test_methods_static_methods_properties_and_constants_work_on_the_array():
     assert "h[1..3] (Helped array)" in origins(Helpers())
     res = bg.simulate(Helpers(), stop_time=1.0, interval=0.5, **TIGHT)
     for k, a in enumerate((0.5, 1.0, 1.5), start=1):
