@@ -100,7 +100,7 @@ class _Flattener(ConnectionLowering):
                             connections.append((eq, elem))
                         else:
                             pending.append((eq, elem))
-                if children:
+                if "_arrays" in elem.__dict__:         # it has arrays (of components?)
                     self._array_equations(elem, path, vectorized)
             if children:
                 prefix = f"{path}." if path else ""

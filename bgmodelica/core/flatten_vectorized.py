@@ -89,8 +89,8 @@ class _View:
 
 
 def array_children(children: dict[str, Any]) -> dict[str, list[Any]]:
-    """Components named ``name[1]``, ``name[2]``... among ``children`` (as ``array_of`` and
-    Modelica arrays of components make them), by ``name``; two or more each."""
+    """Components named ``name[1]``, ``name[2]``... among ``children`` (as ``array_of``
+    makes them), by ``name``; two or more each."""
     groups: dict[str, list[Any]] = {}
     for key, child in children.items():
         if key[-1] == "]" and isinstance(child, Component):
