@@ -34,7 +34,7 @@ from .expr import (
 )
 from .flatmodel import EquationSources, FlatEquation, FlatModel, FlatVariable, take
 from .flatten_connections import ConnectionLowering
-from .flatten_vectorized import array_children, array_equations
+from .flatten_vectorized import GROUP_FROM, array_equations, component_groups
 from .variables import (
     KIND_INPUT,
     KIND_PARAMETER,
@@ -73,7 +73,8 @@ class _Flattener(ConnectionLowering):
         self.blocks: list[tuple[ArrayEquation, str]] = []   # array equations lowered whole
         self.initial_sources: list[tuple[Equation, str]] = []   # initial equations as written
         self.array_rows: dict[int, Any] = {}      # declared arrays' rows (flatten_arrays)
-        self.arrays: list[list[Component]] = []   # arrays of components written once
+        self.arrays: list[Any] = []               # groups of components written once
+        self.row_origins: dict[int, list[str]] = {}   # id(their equation) -> element origins
 
     # -- tree walk -------------------------------------------------------------------------
     def run(self, name: str) -> FlatModel:
@@ -100,8 +101,8 @@ class _Flattener(ConnectionLowering):
                             connections.append((eq, elem))
                         else:
                             pending.append((eq, elem))
-                if "_arrays" in elem.__dict__:         # it has arrays (of components?)
-                    self._array_equations(elem, path, vectorized)
+                if len(children) >= GROUP_FROM or "_arrays" in elem.__dict__:
+                    self._group_equations(elem, path, vectorized)
             if children:
                 prefix = f"{path}." if path else ""
                 stack.extend((child, prefix + child_name, elem)
@@ -128,20 +129,24 @@ class _Flattener(ConnectionLowering):
                               *[take(self.all_sx, self._rows(entries)) for entries in self.entries])
         return flat
 
-    def _array_equations(self, elem: Component, path: str, vectorized: set[int]) -> None:
-        """Equations of ``elem``'s arrays of components (children ``name[1]`` ..) written
-        once per array where exact (:mod:`.flatten_vectorized`); those elements are then
-        not asked for theirs."""
-        for base, items in array_children(elem._children).items():
+    def _group_equations(self, elem: Component, path: str, vectorized: set[int]) -> None:
+        """Equations of groups of ``elem``'s children written once per group where exact
+        (:mod:`.flatten_vectorized`); those children are then not asked for theirs. Each
+        scalar equation keeps its element's origin (``row_origins``)."""
+        prefix = f"{path}." if path else ""
+        for names, items in component_groups(elem):
             eqs = array_equations(items)
             if eqs is None:
                 continue
-            where = f"{path}.{base}" if path else base
+            cls = type(items[0]).__name__
+            wheres = [f"{prefix}{name} ({cls})" for name in names]
+            self.origins.update(zip(map(id, items), wheres, strict=True))
             self.origins[id(items)] = \
-                f"{where}[1..{len(items)}] ({type(items[0]).__name__} array)"
+                f"{prefix}{names[0]} .. {names[-1]} ({len(items)} {cls} components)"
             self.pending.extend((eq, items) for eq in eqs)    # type: ignore[misc]
-            self.arrays.append(items)              # keeps id(items) unique while flattening
-            vectorized.update(id(item) for item in items)
+            self.row_origins.update((id(eq), wheres) for eq in eqs)
+            self.arrays.append((items, eqs))       # keeps the ids above unique meanwhile
+            vectorized.update(map(id, items))
 
     def _initial_equations(self) -> list[FlatEquation]:
         """Lower the components' ``initial_equations()`` (Modelica ``initial equation``) to
@@ -394,8 +399,7 @@ class _Flattener(ConnectionLowering):
             col = [m[1][k] for m in members]
             const_vecs.append(col[0] if all(c == col[0] for c in col) else ca.DM(col))
         shape_l, shape_r = key
-        n_l = _count_leaves(shape_l)
-        c_l = _count_consts(shape_l)
+        n_l, c_l = _count(shape_l, "L"), _count(shape_l, "C")
         lhs = lower_group(shape_l, leaf_vecs[:n_l], const_vecs[:c_l])
         rhs = lower_group(shape_r, leaf_vecs[n_l:], const_vecs[c_l:])
         res = ca.SX(lhs - rhs)
@@ -416,13 +420,15 @@ class _Flattener(ConnectionLowering):
         res, size = flatten_arrays.residual(eq, where, self.pos, self.all_sx, self._alien,
                                             self.array_rows)
         pairs = flatten_arrays.alias_pairs(eq)
+        wheres = self.row_origins.get(id(eq)) or [where] * size
         if pairs is None:
-            self.equations.extend(FlatEquation(None, where, at=(res, k)) for k in range(size))
+            self.equations.extend(FlatEquation(None, wheres[k], at=(res, k))
+                                  for k in range(size))
         else:
             sa, sb, a, b = pairs
             self.equations.extend(
-                FlatEquation(None, where, self._alias_of(sa, la.sym, sb, lb.sym), at=(res, k))
-                for k, (la, lb) in enumerate(zip(a, b, strict=True)))
+                FlatEquation(None, wheres[k], self._alias_of(sa, la.sym, sb, lb.sym),
+                             at=(res, k)) for k, (la, lb) in enumerate(zip(a, b, strict=True)))
         self.columns.append(res)
 
     def _alien(self, sym: Any, eq: Any, where: str) -> EquationError:
@@ -468,20 +474,11 @@ def _side_shape(side: Any, leaves: list, consts: list) -> Any:
     raise TypeError(side)
 
 
-def _count_leaves(shape: Any) -> int:
-    if shape == "L":
-        return 1
-    if shape == "C":
-        return 0
-    return sum(_count_leaves(a) for a in shape[1:])
-
-
-def _count_consts(shape: Any) -> int:
-    if shape == "C":
-        return 1
-    if shape == "L":
-        return 0
-    return sum(_count_consts(a) for a in shape[1:])
+def _count(shape: Any, kind: str) -> int:
+    """Leaves (``kind="L"``) or constants (``"C"``) of an equation shape."""
+    if isinstance(shape, str):
+        return int(shape == kind)
+    return sum(_count(a, kind) for a in shape[1:])
 
 
 def _leaf_symbols(e: Any) -> list:

@@ -1,12 +1,13 @@
-"""The equations of an array of components written once for the whole array.
+"""The equations of many components of one class written once for all of them.
 
-``array_of(Resistor, n)`` gives ``n`` components of one class. Their ``equations()`` are the
-same code, so instead of running it ``n`` times (``n`` scalar equations of each kind, each
-walked and grouped by flattening), it runs once on a view of the array in which every variable
-and parameter is the :class:`~.arrays.ArrayExpr` of the elements' scalars and every connector
-a view of the elements' connectors. ``v == R*i`` then comes out as one array equation,
-lowered as a block like a hand-written one (:mod:`.flatten_arrays`): the same scalar equations
-in fewer, larger CasADi operations.
+``array_of(Resistor, n)``, or a ladder built with a resistor per section, gives ``n``
+components of one class. Their ``equations()`` are the same code, so instead of running it
+``n`` times (``n`` scalar equations of each kind, each walked and grouped by flattening), it
+runs once on a view of the group in which every variable and parameter is the
+:class:`~.arrays.ArrayExpr` of the elements' scalars and every connector a view of the
+elements' connectors. ``v == R*i`` then comes out as one array equation, lowered as a block
+like a hand-written one (:mod:`.flatten_arrays`): the same scalar equations, with the same
+origins (each element's path), in fewer, larger CasADi operations.
 
 Only what the view can answer exactly is taken: the elements must be leaf components (no
 subcomponents, no added equations) of one class with the same declarations, and every
@@ -88,16 +89,36 @@ class _View:
         raise _Varies("truth value")
 
 
-def array_children(children: dict[str, Any]) -> dict[str, list[Any]]:
-    """Components named ``name[1]``, ``name[2]``... among ``children`` (as ``array_of``
-    makes them), by ``name``; two or more each."""
-    groups: dict[str, list[Any]] = {}
-    for key, child in children.items():
-        if key[-1] == "]" and isinstance(child, Component):
-            base, _, index = key[:-1].partition("[")
-            if index.isdigit():
-                groups.setdefault(base, []).append(child)
-    return {base: items for base, items in groups.items() if len(items) > 1}
+#: siblings of one class written once from this many on (arrays of components from two)
+GROUP_FROM = 16
+
+
+def component_groups(elem: Component) -> list[tuple[list[str], list[Any]]]:
+    """Children of ``elem`` whose equations may be written once: its arrays of components
+    (``name[1]``, ``name[2]``..., as ``array_of`` makes them, two or more) and, among the
+    rest, the components of one class when there are :data:`GROUP_FROM` or more (a
+    component per section of a ladder). Each group as ``(child names, children)``."""
+    children = elem._children
+    arrays: dict[str, tuple[list[str], list[Any]]] = {}
+    if "_arrays" in elem.__dict__:
+        for key, child in children.items():
+            if key[-1] == "]" and isinstance(child, Component):
+                base, _, index = key[:-1].partition("[")
+                if index.isdigit():
+                    names, items = arrays.setdefault(base, ([], []))
+                    names.append(key)
+                    items.append(child)
+    out = [group for group in arrays.values() if len(group[1]) > 1]
+    if len(children) >= GROUP_FROM:
+        taken = {id(c) for _, items in out for c in items}
+        by_class: dict[type, tuple[list[str], list[Any]]] = {}
+        for key, child in children.items():
+            if isinstance(child, Component) and id(child) not in taken:
+                names, items = by_class.setdefault(type(child), ([], []))
+                names.append(key)
+                items.append(child)
+        out += [group for group in by_class.values() if len(group[1]) >= GROUP_FROM]
+    return out
 
 
 def array_equations(items: list[Any]) -> list[ArrayEquation] | None:

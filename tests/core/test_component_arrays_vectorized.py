@@ -1,42 +1,60 @@
-"""Arrays of components: their equations written once for the whole array (one array
-equation per equation of the class) where that is exact, element by element otherwise."""
+"""Arrays of components, and many sibling components of one class: their equations written
+once for the whole group (one array equation per equation of the class, each scalar keeping
+its element's origin) where that is exact, element by element otherwise."""
 
 from __future__ import annotations
 
 import math
+from collections import Counter
 
 import casadi as ca
 import numpy as np
+import pytest
 
 import bgmodelica as bg
 from bgmodelica import Component, Parameter, Variable, array_of, der, time
 from bgmodelica.core.flatten import flatten
+from bgmodelica.core.flatten_vectorized import GROUP_FROM
 from bgmodelica.core.variables import TIME
-from library.examples import RCLadder, RCLadderArrays
+from library.examples import RCLadder, RCLadderArrays, RCLadderVector
 
 TIGHT = {"rtol": 1e-10, "atol": 1e-12}
 
 
-def origins(model: Component) -> set[str]:
-    return {eq.origin for eq in flatten(model).equations}
+def blocks(model: Component) -> set[str]:
+    """Origins of the groups whose equations were written once."""
+    return {where for _, where in flatten(model).sources.arrays}
 
 
 def test_library_component_arrays_are_written_once():
-    got = origins(RCLadderArrays(6))
-    assert {"R[1..6] (Resistor array)", "C[1..6] (Capacitor array)"} <= got
-    assert not any(o.startswith(("R[3] (", "C[3] (")) for o in got)
+    assert {"R[1] .. R[6] (6 Resistor components)",
+            "C[1] .. C[6] (6 Capacitor components)"} <= blocks(RCLadderArrays(6))
 
 
-def test_same_scalar_equations_as_element_by_element(monkeypatch):
-    """The flat model of the array form has the same variables and, equation by equation,
-    the same residuals (compared numerically at a random point) as without vectorizing."""
+def test_many_siblings_of_one_class_are_written_once():
+    assert {"R1 .. R40 (40 Resistor components)",
+            "C1 .. C40 (40 Capacitor components)"} <= blocks(RCLadder(40))
+    assert not blocks(RCLadder(GROUP_FROM - 1))
+    a = bg.simulate(RCLadder(40), stop_time=0.2, interval=0.02, **TIGHT)
+    b = bg.simulate(RCLadderVector(40), stop_time=0.2, interval=0.02, **TIGHT)
+    assert np.max(np.abs(a["C40.v"] - b["v[40]"])) < 1e-12
+    assert np.max(np.abs(a["R7.i"] - b["i[7]"])) < 1e-9
+
+
+@pytest.mark.parametrize("make", [lambda: RCLadderArrays(5), lambda: RCLadder(GROUP_FROM)])
+def test_same_scalar_equations_as_element_by_element(make, monkeypatch):
+    """The flat model has the same variables, the same equation origins and, equation by
+    equation, the same residuals (compared numerically at a random point) as without
+    writing the groups once."""
     from bgmodelica.core import flatten as flatten_module
 
-    fast = flatten(RCLadderArrays(5))
-    monkeypatch.setattr(flatten_module, "array_equations", lambda arr: None)
-    slow = flatten(RCLadderArrays(5))
+    fast = flatten(make())
+    assert fast.sources.arrays
+    monkeypatch.setattr(flatten_module, "array_equations", lambda items: None)
+    slow = flatten(make())
+    assert not slow.sources.arrays
     assert [v.name for v in fast.variables] == [v.name for v in slow.variables]
-    assert len(fast.equations) == len(slow.equations)
+    assert Counter(e.origin for e in fast.equations) == Counter(e.origin for e in slow.equations)
     rng = np.random.default_rng(1)
     values: dict[str, float] = {}
 
@@ -119,8 +137,7 @@ class Bank(Component):
 
 def test_a_plain_attribute_that_differs_falls_back_to_element_by_element():
     model = Bank([1.0, -2.0, 3.0], [True, False, True])
-    got = origins(Bank([1.0, -2.0, 3.0], [True, False, True]))
-    assert "s[2] (Scaled)" in got and "w[2] (Switched)" in got
+    assert not blocks(Bank([1.0, -2.0, 3.0], [True, False, True]))
     res = bg.simulate(model, stop_time=1.0, interval=0.5, **TIGHT)
     assert np.allclose(res["s[2].y"], -2.0 * res.time)
     assert math.isclose(res["w[1].x"][-1], math.exp(-2.0), rel_tol=1e-8)
@@ -128,8 +145,8 @@ def test_a_plain_attribute_that_differs_falls_back_to_element_by_element():
 
 
 def test_a_plain_attribute_equal_in_every_element_is_used_as_is():
-    got = origins(Bank([2.0, 2.0], [False, False, False]))
-    assert {"s[1..2] (Scaled array)", "w[1..3] (Switched array)"} <= got
+    assert blocks(Bank([2.0, 2.0], [False, False, False])) == {
+        "s[1] .. s[2] (2 Scaled components)", "w[1] .. w[3] (3 Switched components)"}
     res = bg.simulate(Bank([2.0, 2.0], [False, False, False]), stop_time=1.0, interval=0.5,
                       **TIGHT)
     assert np.allclose(res["s[2].y"], 2.0 * res.time)
@@ -140,8 +157,7 @@ def test_an_element_with_an_added_equation_is_not_vectorized():
     model = Bank([1.0, 1.0], [True, True])
     model.s[0].declare("z", Variable())
     model.s[0].equation(model.s[0].z == 5.0)
-    got = origins(model)
-    assert "s[1] (Scaled)" in got and "w[1..2] (Switched array)" in got
+    assert blocks(model) == {"w[1] .. w[2] (2 Switched components)"}
     res = bg.simulate(model, stop_time=0.5, interval=0.5, **TIGHT)
     assert res["s[1].z"][-1] == 5.0
 
@@ -153,7 +169,7 @@ class Helpers(Component):
 
 
 def test_methods_static_methods_properties_and_constants_work_on_the_array():
-    assert "h[1..3] (Helped array)" in origins(Helpers())
+    assert blocks(Helpers()) == {"h[1] .. h[3] (3 Helped components)"}
     res = bg.simulate(Helpers(), stop_time=1.0, interval=0.5, **TIGHT)
     for k, a in enumerate((0.5, 1.0, 1.5), start=1):
         assert math.isclose(res[f"h[{k}].x"][-1], math.exp(-2.0 * a), rel_tol=1e-8)
