@@ -89,8 +89,9 @@ class _View:
         raise _Varies("truth value")
 
 
-#: siblings of one class written once from this many on (arrays of components from two)
-GROUP_FROM = 16
+#: siblings of one class written once from this many on (arrays of components from two);
+#: below it the fixed cost of a group (views, block lowering) outweighs the per-element one
+GROUP_FROM = 64
 
 
 def component_groups(elem: Component) -> list[tuple[list[str], list[Any]]]:

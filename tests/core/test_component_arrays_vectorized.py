@@ -32,12 +32,13 @@ def test_library_component_arrays_are_written_once():
 
 
 def test_many_siblings_of_one_class_are_written_once():
-    assert {"R1 .. R40 (40 Resistor components)",
-            "C1 .. C40 (40 Capacitor components)"} <= blocks(RCLadder(40))
+    n = GROUP_FROM + 4
+    assert {f"R1 .. R{n} ({n} Resistor components)",
+            f"C1 .. C{n} ({n} Capacitor components)"} <= blocks(RCLadder(n))
     assert not blocks(RCLadder(GROUP_FROM - 1))
-    a = bg.simulate(RCLadder(40), stop_time=0.2, interval=0.02, **TIGHT)
-    b = bg.simulate(RCLadderVector(40), stop_time=0.2, interval=0.02, **TIGHT)
-    assert np.max(np.abs(a["C40.v"] - b["v[40]"])) < 1e-12
+    a = bg.simulate(RCLadder(n), stop_time=0.2, interval=0.02, **TIGHT)
+    b = bg.simulate(RCLadderVector(n), stop_time=0.2, interval=0.02, **TIGHT)
+    assert np.max(np.abs(a[f"C{n}.v"] - b[f"v[{n}]"])) < 1e-12
     assert np.max(np.abs(a["R7.i"] - b["i[7]"])) < 1e-9
 
 
