@@ -73,7 +73,7 @@ class _Flattener(ConnectionLowering):
         self.blocks: list[tuple[ArrayEquation, str]] = []   # array equations lowered whole
         self.initial_sources: list[tuple[Equation, str]] = []   # initial equations as written
         self.array_rows: dict[int, Any] = {}      # declared arrays' rows (flatten_arrays)
-        self.arrays: list[Any] = []               # groups of components written once
+        self.written_once: list[Any] = []         # groups of components written once
         self.row_origins: dict[int, list[str]] = {}   # id(their equation) -> element origins
 
     # -- tree walk -------------------------------------------------------------------------
@@ -145,7 +145,7 @@ class _Flattener(ConnectionLowering):
                 f"{prefix}{names[0]} .. {names[-1]} ({len(items)} {cls} components)"
             self.pending.extend((eq, items) for eq in eqs)    # type: ignore[misc]
             self.row_origins.update((id(eq), wheres) for eq in eqs)
-            self.arrays.append((items, eqs))       # keeps the ids above unique meanwhile
+            self.written_once.append((items, eqs))  # keeps the ids above unique meanwhile
             vectorized.update(map(id, items))
 
     def _initial_equations(self) -> list[FlatEquation]:
