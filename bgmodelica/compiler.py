@@ -48,6 +48,17 @@ class CompiledModel:
 
         return compiled_html(self)
 
+    @property
+    def declarations(self) -> Any:
+        """The flat model simulation reads declarations, units and aliases from (the
+        index-reduced one)."""
+        return self.reduced.model
+
+    @property
+    def has_state_choice(self) -> bool:
+        """Whether index reduction left a choice of states (dummy derivatives)."""
+        return self.reduced.has_choice
+
     def needs_dynamic_selection(self) -> bool:
         """Whether simulation must be ready to change the states (their pivots vary)."""
         if not self.reduced.has_choice:
@@ -141,6 +152,13 @@ def compile(model: Component, *, select: Selector | None = None,  # noqa: A001
 
     The cyclic garbage collector is paused meanwhile: compilation allocates millions of
     objects that live until the end, and rescanning them costs more than it frees."""
+    if select is None:
+        from .array_path import compile_arrays
+
+        with gc_paused():
+            fast = compile_arrays(model, units)
+        if fast is not None:
+            return fast
     if cache is False or cache is None or select is not None:
         with gc_paused():
             return _compile(model, select, units)

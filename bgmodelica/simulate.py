@@ -121,7 +121,7 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
         from .analysis.steady_state import steady_state_dae
 
         dae = steady_state_dae(compiled, dae, p, start_time, init)
-    check_values(dae, p, compiled.reduced.model)
+    check_values(dae, p, compiled.declarations)
     grid = output_grid(start_time, stop_time, interval,        # exactly the points asked for
                        len(outputs) if outputs is not None else len(dae.names))
     selection = _selection(compiled, dynamic, start_over, stop_time - start_time)
@@ -154,7 +154,7 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
         return result
     init = initialize(dae, p, start_time)
     check_initial_point(dae, init.x0, init.z0, p, start_time)
-    obs_idx = _output_indices(dae, outputs, compiled.reduced.model.aliases)
+    obs_idx = _output_indices(dae, outputs, compiled.declarations.aliases)
     opts = {"abstol": atol, "reltol": rtol, "max_num_steps": max_steps,
             "calc_ic": False,   # initialize() already made x0, z0 consistent
             **extra}
@@ -167,7 +167,7 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
               if n_ok else np.zeros((0, len(obs_idx))))
     run = _time.perf_counter() - t_start
     names = [dae.names[k] for k in obs_idx]
-    flat = compiled.reduced.model
+    flat = compiled.declarations
     units = _units_by_name(dae, flat)
     params_out = dae.parameter_values(p)
     meta = {"compile_seconds": compiled.compile_time, "run_seconds": run,
@@ -478,7 +478,7 @@ def _selection(compiled: CompiledModel, dynamic: bool, start_over: dict[str, Any
 
 def _selector(compiled: CompiledModel):
     """The dynamic state selector of a model that needs one (cached on the model), or None."""
-    if not compiled.reduced.has_choice:
+    if not compiled.has_state_choice:
         return None
     from .dynamic_selection import StateSelector
 

@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.arrays import ArrayExpr, array_text
+from ..core.arrays import ArrayEquation, ArrayExpr, array_text
 from ..core.expr import Equation, Expr, Leaf, Number, Op, to_text
 from ..core.flatmodel import EquationSources, FlatModel
 from ..core.hybrid import Reinit, SampleClock
@@ -72,7 +72,26 @@ def check_units(flat: FlatModel, mode: str = "error") -> list[str]:
         raise ValueError(f"units must be one of {', '.join(map(repr, MODES))}, got {mode!r}")
     if mode == "off" or flat.sources is None:
         return []
-    problems = _Checker(mode == "error").run(flat.sources)
+    return check_sources(flat.sources, mode)
+
+
+def check_equations(equations: list[Any], where: str, mode: str = "error") -> list[str]:
+    """:func:`check_units` of equations written at ``where`` (array equations lowered as
+    blocks, and scalar equations), without a flat model."""
+    if mode not in MODES:
+        raise ValueError(f"units must be one of {', '.join(map(repr, MODES))}, got {mode!r}")
+    if mode == "off":
+        return []
+    arrays = [(eq, where) for eq in equations if isinstance(eq, ArrayEquation)]
+    scalars = [eq for eq in equations if not isinstance(eq, ArrayEquation)]
+    return check_sources(EquationSources(groups=_scalar_groups(scalars, where), arrays=arrays),
+                         mode)
+
+
+def check_sources(sources: EquationSources, mode: str) -> list[str]:
+    """:func:`check_units` of equations as the user wrote them (``mode`` "error" or
+    "warn")."""
+    problems = _Checker(mode == "error").run(sources)
     for msg in problems:
         warnings.warn(msg, UnitWarning, stacklevel=3)
     return problems

@@ -1,0 +1,160 @@
+"""The array path: large leaf models of array equations compiled without a Python object
+per scalar.
+
+``compile`` sends a model here first (:func:`compile_arrays`). A model it takes (see
+:mod:`.collect`) is lowered to MX blocks (:mod:`.lowering`), ordered on its integer incidence
+(:mod:`bgmodelica.structure.explicit_order`), solved block by block and assembled into the
+same :class:`~bgmodelica.backends.casadi_dae.CasadiDAE` the scalar pipeline builds: the same
+variable names and order, states, parameters, start values and ODE. A model it does not take,
+or whose blocks do not solve explicitly (an algebraic loop, a higher index, an unbalanced or
+singular system), goes through the scalar pipeline, which also gives the precise errors.
+
+What simulation needs is ready at once. The scalar structures (``flat``, ``balance``,
+``reduced``, ``sorted``), which FMU export, ``check`` and the analyses read, are built by
+the scalar pipeline on first use (:class:`ArrayCompiledModel`), and their time is added to
+``timings`` as ``scalar_structures``.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from typing import Any
+
+import numpy as np
+
+from ..compiler import CompiledModel
+from ..structure.explicit_order import explicit_order
+from .build import assemble, solve_blocks
+from .collect import ARRAY_PATH_FROM, collect
+from .lowering import Lowered
+
+__all__ = ["ARRAY_PATH_FROM", "ArrayCompiledModel", "compile_arrays", "why_not"]
+
+_DEFERRED = ("flat", "balance", "reduced", "sorted")
+
+
+def why_not(model: Any, minimum: int | None = None) -> str | None:
+    """Why ``model`` does not take the array path (None when it does)."""
+    found = _build(model, "off", minimum)
+    return found if isinstance(found, str) else None
+
+
+def compile_arrays(model: Any, units: str = "error",
+                   minimum: int | None = None) -> ArrayCompiledModel | None:
+    """``model`` compiled by the array path, or None when it goes the scalar way."""
+    found = _build(model, units, minimum)
+    return None if isinstance(found, str) else found
+
+
+def _build(model: Any, units: str, minimum: int | None) -> ArrayCompiledModel | str:
+    from ..passes.units import check_equations
+
+    timings: dict[str, float] = {}
+    t = _time.perf_counter()
+
+    def lap(stage: str) -> None:
+        nonlocal t
+        now = _time.perf_counter()
+        timings[stage] = now - t
+        t = now
+
+    col = collect(model, minimum)
+    if isinstance(col, str):
+        return col
+    lap("collect")
+    check_equations(col.equations, col.where, units)
+    lap("units")
+    try:
+        low = Lowered(col)
+    except KeyError:          # a symbol of another component: the scalar path says which
+        return "an equation uses a symbol that is not part of the model"
+    lap("lowering")
+    is_state = np.fromiter((s.der is not None for s in col.order), bool, len(col.order))
+    unknown = np.flatnonzero(~is_state)
+    if unknown.size != col.n_rows:
+        return f"{col.n_rows} equations for {unknown.size} unknowns"
+    as_unknown = np.full(low.n + low.n_p + 1, -1, dtype=np.int64)
+    as_unknown[unknown] = np.arange(unknown.size)
+    cols = as_unknown[low.cols]
+    used = cols >= 0
+    order = explicit_order(unknown.size, low.rows[used], cols[used], low.sizes)
+    if isinstance(order, str):
+        return order
+    lap("structure")
+    solved = solve_blocks(low, order, unknown)
+    if isinstance(solved, str):
+        return solved
+    lap("solve")
+    dae = assemble(col, low, solved, np.flatnonzero(is_state))
+    lap("backend")
+    return ArrayCompiledModel.made(col.name, dae, col.n_rows, timings, model, units,
+                                   col.order)
+
+
+class ArrayCompiledModel(CompiledModel):
+    """A :class:`~bgmodelica.compiler.CompiledModel` made by the array path: ``dae`` is
+    ready; ``flat``, ``balance``, ``reduced`` and ``sorted`` are made by the scalar pipeline
+    when first read (and ``dae`` is then the scalar pipeline's, which is the same model)."""
+
+    @classmethod
+    def made(cls, name: str, dae: Any, n_equations: int, timings: dict[str, float],
+             source: Any, units: str, variables: list[Any]) -> ArrayCompiledModel:
+        self = object.__new__(cls)
+        self.__dict__.update(name=name, dae=dae, n_flat_equations=n_equations,
+                             timings=timings, source=source, _units=units,
+                             _variables=variables)
+        return self
+
+    def __getattr__(self, attr: str) -> Any:
+        if attr in _DEFERRED and "source" in self.__dict__:
+            self._complete()
+            return self.__dict__[attr]
+        raise AttributeError(attr)
+
+    def _complete(self) -> None:
+        """Build the scalar structures (and their DAE) by the scalar pipeline."""
+        from ..compiler import _compile
+        from ..structure.graph import gc_paused
+
+        if self.source is None:
+            raise RuntimeError(f"{self.name}: the scalar structures of a model compiled by "
+                               "the array path need its source component")
+        t0 = _time.perf_counter()
+        with gc_paused():
+            full = _compile(self.source, None, self.__dict__.get("_units", "error"))
+        mine, theirs = self.dae, full.dae
+        if (mine.names != theirs.names or mine.state_names != theirs.state_names
+                or [q.name for q in mine.parameters] != [q.name for q in theirs.parameters]):
+            raise RuntimeError(f"{self.name}: the array path and the scalar pipeline made "
+                               "different models (please report this)")
+        for attr in _DEFERRED:
+            self.__dict__[attr] = getattr(full, attr)
+        self.__dict__["dae"] = theirs
+        self.timings["scalar_structures"] = _time.perf_counter() - t0
+
+    @property
+    def declarations(self) -> Any:
+        """What simulation reads of the flat model (see :class:`Declarations`)."""
+        if "reduced" in self.__dict__:
+            return self.reduced.model
+        found = self.__dict__.get("_declarations")
+        if found is None:
+            found = self.__dict__["_declarations"] = Declarations(self)
+        return found
+
+    @property
+    def has_state_choice(self) -> bool:
+        return False
+
+
+class Declarations:
+    """The variables and parameters of a model compiled by the array path, as simulation
+    reads them from a flat model (names, declarations; no aliases, inputs or discretes)."""
+
+    def __init__(self, compiled: ArrayCompiledModel) -> None:
+        self.name = compiled.name
+        self.variables = compiled.__dict__["_variables"]
+        self.parameters = compiled.dae.parameters
+        self.inputs: list[Any] = []
+        self.discretes: list[Any] = []
+        self.aliases: dict[str, tuple[str, float]] = {}

@@ -1,0 +1,91 @@
+"""Solve the blocks of a lowered model in order and assemble its :class:`CasadiDAE`.
+
+Each block is solved for its unknowns as one MX operation: a residual ``r`` linear in its
+own unknowns ``u`` with a coefficient that does not depend on them gives
+``u = -r(u = 0) / (dr/du)``, the coefficient being the directional derivative along a seed
+that is 1 on ``u`` (each row uses only its own unknown of the block, see
+:mod:`bgmodelica.structure.explicit_order`). Solutions are substituted block after block,
+and the result is evaluated once on the SX symbols the rest of the tool works with: the ODE
+``der(x) = f(t, x, p)`` and the observation of every variable.
+"""
+
+from __future__ import annotations
+
+from itertools import repeat
+from operator import attrgetter
+
+import casadi as ca
+import numpy as np
+
+from ..backends.casadi_dae import CSE_UP_TO, CasadiDAE
+from ..core.flatmodel import FlatVariable
+from ..core.variables import TIME
+from ..structure.explicit_order import ExplicitOrder
+from .collect import Collected
+from .lowering import Lowered
+
+_NAME, _DECL = attrgetter("name"), attrgetter("decl")
+
+
+def solve_blocks(low: Lowered, order: ExplicitOrder, unknown: np.ndarray) -> ca.MX | str:
+    """Every column of ``x`` as an MX expression of the states, ``p`` and ``t`` (the
+    unknowns, columns ``unknown``, replaced by their solutions), or why a block does not
+    solve explicitly."""
+    n = low.n
+    starts = np.concatenate([[0], np.cumsum(low.sizes)]).astype(np.int64)
+    current = low.x
+    for b in order.blocks:
+        r = low.blocks[b]
+        mine = unknown[order.unknown_of[starts[b]:starts[b + 1]]]
+        seed = ca.DM(_column(n, np.sort(mine)), 1.0)
+        coefficient = ca.jtimes(r, low.x, seed)
+        if coefficient.nnz() != r.numel():
+            return f"block {b}: an unknown's coefficient is structurally zero"
+        if ca.jtimes(coefficient, low.x, seed).nnz():
+            return f"block {b}: not linear in its unknowns"
+        others = np.ones(n, dtype=bool)
+        others[mine] = False
+        zeroed = ca.project(low.x, _column(n, np.flatnonzero(others)))
+        solution = ca.substitute(-ca.substitute(r, low.x, zeroed) / coefficient, low.x,
+                                 current)
+        current = ca.MX(current)
+        current[mine.tolist()] = solution
+    return current
+
+
+def _column(n: int, rows: np.ndarray) -> ca.Sparsity:
+    """The sparsity of an ``n``-vector with entries at ``rows`` (ascending)."""
+    return ca.Sparsity(n, 1, [0, int(rows.size)], rows.tolist())
+
+
+def assemble(col: Collected, low: Lowered, solved: ca.MX, states: np.ndarray) -> CasadiDAE:
+    """The :class:`CasadiDAE` of the model: the same names, orders, states and parameters
+    as the scalar pipeline's. Its SX symbols are one column ``v``: the states, then the
+    parameters (the other variables are observations)."""
+    n, n_p = low.n, low.n_p
+    n_x = states.size
+    order = col.order
+    column = ca.SX.sym("v", n_x + n_p)
+    x, p = column[:n_x], column[n_x:]
+    state_list = states.tolist()
+    x_in = ca.SX(ca.Sparsity(n, 1, [0, n_x], state_list), x)   # the others are solved
+    derivatives = [j + 1 for j in state_list]                   # der(x) follows x
+    f = ca.Function("array_path", [low.x, low.p, low.t], [solved[derivatives], solved])
+    ode, observed = f(x_in, p, TIME.sx)
+    if n_x + n <= CSE_UP_TO:
+        both = ca.cse(ca.vertcat(ode, observed))
+        ode, observed = both[:n_x], both[n_x:]
+    names = list(map(_NAME, order))
+    parameters = list(map(FlatVariable, map(_NAME, col.params), repeat(None),
+                          map(_DECL, col.params), repeat(""), repeat(-1), repeat(-1),
+                          zip(repeat(column), range(n_x, n_x + n_p))))
+    return CasadiDAE(
+        x=x, z=ca.SX(0, 1), p=p if n_p else ca.SX(0, 1),
+        t=TIME.sx, ode=ode, alg=ca.SX(0, 1), observed=observed,
+        names=names, state_names=[names[j] for j in state_list], algebraic_names=[],
+        parameters=parameters, inputs=[],
+        x_start=np.array([float(order[j].decl.start) for j in state_list], dtype=float),
+        z_start=np.zeros(0), fixed=[(k, float(s.decl.start)) for k, s in enumerate(order)
+                                    if s.der_of is None and s.decl.fixed],
+        observed_index=dict(zip(names, range(n), strict=True)), n_variables=n,
+        differentiated={names[j] for j in state_list})

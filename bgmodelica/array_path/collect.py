@@ -1,0 +1,217 @@
+"""Which models take the array path, and their columns.
+
+The array path (:mod:`bgmodelica.array_path`) compiles a *leaf* model written with array
+equations without making a Python object per scalar. It takes a model only when the result
+is the one the scalar pipeline gives; anything else goes the usual way:
+
+- one component, without subcomponents, connectors, connections or initial equations;
+- plain :class:`~bgmodelica.core.variables.Variable` (default state selection) and
+  :class:`~bgmodelica.core.variables.Parameter` declarations, parameters given as numbers;
+- equations that are array equations lowered as blocks, or a few scalar equations, built
+  from whole-array arithmetic and the smooth math functions (no relations, events or
+  ``if_else``), none of them an alias ``a == b`` between two variables;
+- at least :data:`ARRAY_PATH_FROM` scalar equations (below, the scalar pipeline is as fast).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from itertools import compress
+from operator import attrgetter
+from typing import Any
+
+import numpy as np
+
+from ..core.arrays import ArrayEquation, _block_operand
+from ..core.component import Component, _own_methods
+from ..core.expr import Equation, Leaf, Op, alias_signs, shape_of
+from ..core.flatten_arrays import alias_pairs
+from ..core.variables import KIND_VARIABLE, TIME, Parameter, StateSelect, Symbol, Variable
+
+#: the array path is used from this many scalar equations on
+ARRAY_PATH_FROM = 1000
+#: at most this many scalar (non-array) equations: each is lowered on its own
+MAX_SCALAR_EQUATIONS = 256
+
+
+@dataclass
+class Collected:
+    """A model the array path takes: ``order`` holds its variables in the order of the
+    scalar pipeline (each variable followed by its time derivative, if used), ``params`` its
+    parameters in declaration order; ``equations`` are the equations and ``n_rows`` their
+    number of scalar equations. ``pos`` maps ``id(symbol)`` to its column (variables and
+    derivatives, then parameters, then time) and ``memo`` the declared arrays to their
+    columns (as :func:`~bgmodelica.core.flatten_arrays.residual` reads them)."""
+
+    name: str
+    where: str
+    order: list[Symbol]
+    params: list[Symbol]
+    equations: list[Any]
+    n_rows: int
+    pos: dict[int, int]
+    memo: dict[int, Any]
+
+
+_DECL = attrgetter("decl")
+
+
+def collect(model: Any, minimum: int | None = None) -> Collected | str:
+    """The model's columns and equations, or why it does not take the array path."""
+    if not isinstance(model, Component) or type(model) is Component:
+        return "not a component class"
+    if model._children:
+        return "it has subcomponents"
+    if "_mo_env" in type(model).__dict__:
+        return "a Modelica class"
+    symbols = list(model._symbols.values())
+    decls = list(map(_DECL, symbols))
+    is_var = np.fromiter(map(Variable.__instancecheck__, decls), bool, len(decls))
+    kinds = set(map(type, decls))
+    if not kinds <= {Variable, Parameter}:
+        bad = next(d for d in decls if type(d) not in (Variable, Parameter))
+        return f"a {type(bad).__name__} is declared"
+    variables = list(compress(symbols, is_var))
+    params = list(compress(symbols, ~is_var))
+    var_decls = list(compress(decls, is_var))
+    if set(map(attrgetter("state_select"), var_decls)) - {StateSelect.DEFAULT}:
+        return "a variable has a state selection"
+    if set(map(type, map(attrgetter("value"), compress(decls, ~is_var)))) - {float, int}:
+        return "a parameter is not given as a number"
+    if _own_methods(type(model), "initial_equations") != (Component.initial_equations,) \
+            or model.__dict__.get("_initial_equations"):
+        return "it has initial equations"        # (not called here: they may make symbols)
+    minimum = ARRAY_PATH_FROM if minimum is None else minimum
+    if len(variables) < minimum:       # a balanced model has one equation per variable
+        return "small"
+    from ..validate import guarded_equations
+
+    name = model.name or type(model).__name__
+    where = f"top level ({type(model).__name__})"
+    equations = guarded_equations(model, where, "", blocks=True)
+    n_rows = n_scalar = 0
+    for eq in equations:
+        if isinstance(eq, ArrayEquation):
+            if _is_alias_array(eq):
+                return "an array equation is an alias"
+            n_rows += len(eq)
+        elif type(eq) is Equation:
+            n_scalar += 1
+            if n_scalar > MAX_SCALAR_EQUATIONS:
+                return "many scalar equations"
+            if not (_block_operand(eq.lhs) and _block_operand(eq.rhs)):
+                return "a scalar equation is not smooth arithmetic"
+            if _is_alias_scalar(eq):
+                return "a scalar equation is an alias"
+            n_rows += 1
+        else:
+            return f"it has a {type(eq).__name__}"
+    if n_rows < minimum:
+        return "small"
+    # columns: each variable, then its derivative if the equations made one
+    has_der = np.fromiter((s.der is not None for s in variables), bool, len(variables))
+    var_col = np.arange(len(variables)) + np.cumsum(has_der) - has_der
+    n = len(variables) + int(has_der.sum())
+    order = _interleave(variables, has_der, var_col, n)
+    column = np.empty(len(symbols), dtype=np.int64)
+    column[is_var] = var_col
+    column[~is_var] = n + np.arange(len(params))
+    pos, memo = _Positions(symbols, column), {}
+    in_array = np.zeros(len(symbols), dtype=bool)
+    names = list(model._symbols)
+    for key, shape in model.__dict__.get("_arrays", {}).items():
+        start = names.index(f"{key}[{','.join(['1'] * len(shape))}]")
+        size = int(np.prod(shape))
+        pos.arrays[key] = (start, shape)
+        in_array[start:start + size] = True
+        root = getattr(model, key).items
+        while isinstance(root.base, np.ndarray):
+            root = root.base
+        memo[id(root)] = (root, column[start:start + size])
+    for k in np.flatnonzero(~in_array).tolist():
+        pos[id(symbols[k])] = int(column[k])
+    der_of = compress(variables, has_der)
+    pos.update(zip(map(id, map(attrgetter("der"), der_of)), (var_col[has_der] + 1).tolist(),
+                   strict=True))
+    pos[id(TIME)] = n + len(params)
+    return Collected(name, where, order, params, equations, n_rows, pos, memo)
+
+
+def _interleave(variables: list[Any], has_der: np.ndarray, var_col: np.ndarray,
+                n: int) -> list[Any]:
+    """The variables at ``var_col`` and their derivatives right after them, in one list."""
+    out: list[Any] = [None] * n
+    for k, s in zip(var_col.tolist(), variables, strict=True):
+        out[k] = s
+    for k, s in zip((var_col[has_der] + 1).tolist(), compress(variables, has_der),
+                    strict=True):
+        out[k] = s.der
+    return out
+
+
+_ELEMENT = re.compile(r"^(.*)\[([0-9,]+)\]$")
+
+
+class _Positions(dict):
+    """``id(symbol)`` -> column; the elements of declared arrays are added on the first
+    lookup that misses (most equations read them through ``memo``, by slices, and
+    :meth:`of` finds one element by its name)."""
+
+    def __init__(self, symbols: list[Any], column: np.ndarray) -> None:
+        super().__init__()
+        self.symbols, self.column = symbols, column
+        self.all = symbols
+        self.arrays: dict[str, tuple[int, tuple[int, ...]]] = {}
+
+    def of(self, sym: Any) -> int:
+        """The column of ``sym`` (KeyError for a symbol of another component)."""
+        found = self.get(id(sym))
+        if found is not None:
+            return found
+        m = _ELEMENT.match(getattr(sym, "name", ""))
+        run = self.arrays.get(m.group(1)) if m else None
+        if run is not None:
+            start, shape = run
+            index = tuple(int(i) - 1 for i in m.group(2).split(","))
+            if len(index) == len(shape) and all(0 <= i < d for i, d in zip(index, shape,
+                                                                           strict=True)):
+                k = start + int(np.ravel_multi_index(index, shape))
+                if self.all[k] is sym:
+                    return int(self.column[k])
+        return self[id(sym)]
+
+    def __missing__(self, key: int) -> int:
+        if self.symbols is None:
+            raise KeyError(key)
+        self.update(zip(map(id, self.symbols), self.column.tolist(), strict=True))
+        self.symbols = None
+        return self[key]
+
+
+def _is_variable(sym: Any) -> bool:
+    decl = getattr(sym, "decl", None)
+    return decl is not None and decl.kind == KIND_VARIABLE and sym.der_of is None
+
+
+def _is_alias_array(eq: ArrayEquation) -> bool:
+    pairs = alias_pairs(eq)
+    if pairs is None:
+        return False
+    _, _, a, b = pairs
+    return bool(a.size) and _is_variable(a[0].sym) and _is_variable(b[0].sym)
+
+
+def _is_alias_scalar(eq: Equation) -> bool:
+    leaves: list = []
+    consts: list = []
+    shapes = []
+    for side in (eq.lhs, eq.rhs):
+        if isinstance(side, (Leaf, Op)):
+            shapes.append(shape_of(side, leaves, consts))
+        else:
+            consts.append(side)
+            shapes.append("C")
+    if not alias_signs(*shapes) or any(np.asarray(c, dtype=float) != 0.0 for c in consts):
+        return False
+    return all(_is_variable(s) for s in leaves)

@@ -1,0 +1,105 @@
+"""Equations of a collected model as CasADi MX blocks, with their scalar incidence.
+
+The model's scalars are three MX symbols: ``x`` (the variables, each followed by its time
+derivative: the order of the scalar pipeline), ``p`` (the parameters) and ``t``. An array
+equation becomes one MX column of whole-vector operations on slices of them, so its size
+costs nothing here. The incidence (which scalars each scalar equation uses) is read off the
+same slices with numpy: the union of the operands' elements, row by row, as CasADi's sparsity
+propagation through element-wise operations would find it.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from ..core.arrays import ArrayEquation, ArrayExpr
+from ..core.expr import Expr, Leaf, apply_op
+from ..core.flatten_arrays import _rows
+from .collect import Collected
+
+
+class Lowered:
+    """The blocks of a collected model: ``blocks[k]`` is the MX residual column of equation
+    ``k`` (``sizes[k]`` scalar equations); ``rows``/``cols`` the incidence pairs, rows
+    numbered over all blocks, columns over ``x`` (variables and derivatives)."""
+
+    def __init__(self, col: Collected) -> None:
+        n, n_p = len(col.order), len(col.params)
+        self.n, self.n_p = n, n_p
+        self.x, self.p, self.t = ca.MX.sym("x", n), ca.MX.sym("p", n_p), ca.MX.sym("t")
+        self.all = ca.vertcat(self.x, self.p, self.t)
+        self.pos, self.memo = col.pos, col.memo
+        self.blocks: list[ca.MX] = []
+        self.sizes: list[int] = []
+        rows: list[np.ndarray] = []
+        cols: list[np.ndarray] = []
+        start = 0
+        for eq in col.equations:
+            shape = eq.shape if isinstance(eq, ArrayEquation) else ()
+            size = int(np.prod(shape))
+            left, lmaps = self.lower(eq.lhs, shape)
+            right, rmaps = self.lower(eq.rhs, shape)
+            res = left - right
+            if not isinstance(res, ca.MX):
+                res = ca.MX(res)
+            if res.numel() != size:
+                res = ca.repmat(res, size, 1)
+            self.blocks.append(res)
+            self.sizes.append(size)
+            for m in (*lmaps, *rmaps):
+                rows.append(np.arange(start, start + size, dtype=np.int64))
+                cols.append(np.broadcast_to(m, (size,)))
+            start += size
+        self.rows = np.concatenate(rows) if rows else np.zeros(0, dtype=np.int64)
+        self.cols = np.concatenate(cols) if cols else np.zeros(0, dtype=np.int64)
+
+    def lower(self, x: Any, want: tuple[int, ...]) -> tuple[Any, list[np.ndarray]]:
+        """``x`` as an MX column of shape ``want`` (C order) and, per operand array, the
+        column index of each of its elements (broadcast the same way)."""
+        if isinstance(x, ArrayExpr):
+            if x.node is None:
+                idx = np.asarray(_rows(x.items, self.pos, self.memo), dtype=np.int64)
+                col, maps = self.all[idx.tolist()], [idx]
+            else:
+                op, args = x.node
+                parts = [self.lower(a, x.shape) for a in args]
+                col = apply_op(op, [c for c, _ in parts])
+                maps = [np.broadcast_to(m, (x.size,)) if m.size == 1 else m
+                        for _, ms in parts for m in ms]
+            have = x.shape
+            if have != want and x.size != 1:
+                bidx = np.broadcast_to(np.arange(x.size).reshape(have), want).ravel()
+                col = col[bidx.tolist()]
+                maps = [m[bidx] for m in maps]
+            return col, maps
+        if isinstance(x, np.ndarray):
+            return ca.DM(np.broadcast_to(x.astype(float), want).ravel()), []
+        if isinstance(x, Expr):
+            leaves: list[int] = []
+            out = self._scalar(x, leaves)
+            return out, [np.array([k], dtype=np.int64) for k in leaves]
+        return float(x), []
+
+    def _scalar(self, e: Any, leaves: list[int]) -> Any:
+        """A scalar expression tree as MX (its leaves' columns appended to ``leaves``)."""
+        memo: dict[int, Any] = {}
+
+        def go(node: Any) -> Any:
+            if isinstance(node, (float, int)):
+                return float(node)
+            key = id(node)
+            if key in memo:
+                return memo[key]
+            if isinstance(node, Leaf):
+                k = self.pos.of(node.sym)
+                leaves.append(k)
+                out = self.all[k]
+            else:
+                out = apply_op(node.op, [go(a) for a in node.args])
+            memo[key] = out
+            return out
+
+        return go(e)

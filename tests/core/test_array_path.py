@@ -1,0 +1,259 @@
+"""The array path: large leaf models of array equations compiled without a Python object per
+scalar give the DAE of the scalar pipeline, or go the scalar way."""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+import pytest
+
+import bgmodelica as bg
+from bgmodelica import Component, Parameter, StateSelect, Variable, der, exp, time
+from bgmodelica.array_path import ArrayCompiledModel, compile_arrays, why_not
+from bgmodelica.compiler import _compile
+from bgmodelica.errors import UnbalancedModelError, UnitError
+from bgmodelica.structure.explicit_order import explicit_order
+from library.examples import RCLadder, RCLadderVector
+
+TIGHT = {"rtol": 1e-10, "atol": 1e-12}
+
+
+# -- the integer part --------------------------------------------------------------------------
+
+def test_a_triangular_chain_is_ordered_block_after_block():
+    # block 0: e0 uses u0; block 1: e1 uses u0, u1 and e2 uses u0, u2; block 2: e3 uses u1, u3
+    rows = np.array([0, 1, 1, 2, 2, 3, 3])
+    cols = np.array([0, 0, 1, 0, 2, 1, 3])
+    order = explicit_order(4, rows, cols, [1, 2, 1])
+    assert not isinstance(order, str)
+    assert order.unknown_of.tolist() == [0, 1, 2, 3]
+    assert order.blocks == [0, 1, 2]
+
+
+def test_blocks_written_out_of_order_are_sorted():
+    # block 0 uses what block 1 solves
+    order = explicit_order(2, np.array([0, 0, 1]), np.array([0, 1, 1]), [1, 1])
+    assert order.blocks == [1, 0]
+
+
+@pytest.mark.parametrize(("rows", "cols", "sizes", "why"), [
+    ([0, 1], [0, 0], [1, 1], "no perfect matching"),
+    ([0, 0, 1, 1], [0, 1, 0, 1], [1, 1], "algebraic loop"),
+    ([0, 1, 1], [0, 0, 1], [2], "own block"),                 # a recurrence u1 = f(u0)
+    ([0, 0, 1, 1, 2, 2, 3], [0, 3, 1, 2, 2, 0, 3], [2, 1, 1], "cycle"),
+])
+def test_systems_that_do_not_solve_explicitly_say_why(rows, cols, sizes, why):
+    found = explicit_order(sum(sizes), np.array(rows), np.array(cols), sizes)
+    assert isinstance(found, str) and why in found
+
+
+# -- the same DAE as the scalar pipeline -------------------------------------------------------
+
+def _same_dae(a, b) -> None:
+    assert a.names == b.names and a.state_names == b.state_names
+    assert a.algebraic_names == b.algebraic_names == []
+    assert [q.name for q in a.parameters] == [q.name for q in b.parameters]
+    assert np.array_equal(a.x_start, b.x_start) and a.fixed == b.fixed
+    assert np.array_equal(a.p_default, b.p_default)
+    assert a.differentiated == b.differentiated
+    rng = np.random.default_rng(3)
+    x, p = rng.random(a.x.numel()) + 0.5, rng.random(a.p.numel()) + 0.5
+    fa = ca.Function("a", [a.x, a.p, a.t], [a.ode, a.observed])
+    fb = ca.Function("b", [b.x, b.p, b.t], [b.ode, b.observed])
+    for u, v in zip(fa(x, p, 0.37), fb(x, p, 0.37), strict=True):
+        assert np.allclose(np.asarray(u), np.asarray(v), rtol=1e-14, atol=0.0)
+
+
+@pytest.mark.parametrize("n", [1, 2, 5, 64])
+def test_the_ladder_gives_the_scalar_pipelines_dae(n):
+    fast = compile_arrays(RCLadderVector(n), minimum=0)
+    assert isinstance(fast, ArrayCompiledModel)
+    _same_dae(fast.dae, _compile(RCLadderVector(n), None).dae)
+
+
+class DecayDeclarations(Component):
+    """The declarations of :class:`Decays` (equations are inherited: the variants below
+    start from here)."""
+
+    x = Variable(shape="n", unit="m", description="state")
+    y = Variable(shape="n", unit="m", description="twice the state")
+    s = Variable(unit="m", description="first plus last")
+    rate = Parameter(shape="n", value=1.0, unit="1/s")
+    u = Parameter(1.0, unit="m/s")
+
+    def __init__(self, n: int = 4, **modifiers):
+        self.n = n
+        k = np.linspace(0.5, 3.0, n)
+        super().__init__(**{"rate": k, "x": np.linspace(1.0, 2.0, n), **modifiers})
+
+
+class Decays(DecayDeclarations):
+    """``der(x[k]) = -k_k*x[k] + u(t)``, ``y = 2*x`` observed, ``s = x[1] + x[n]``: each
+    ``x[k](t) = x0_k e^{-k_k t} + (1 - e^{-k_k t})/k_k`` for ``u = 1``."""
+
+    def equations(self):
+        yield der(self.x) == -self.rate * self.x + self.u
+        yield self.y == 2.0 * self.x
+        yield self.s == self.x[0] + self.x[-1]
+
+
+def test_a_model_taken_by_compile_matches_the_analytic_solution():
+    n = 1000
+    model = Decays(n)
+    assert why_not(model) is None
+    compiled = bg.compile(model)
+    assert isinstance(compiled, ArrayCompiledModel)
+    res = bg.simulate(compiled, stop_time=2.0, interval=0.1, **TIGHT,
+                      outputs=["x[1]", f"x[{n}]", "y[500]", "s"])
+    k, x0 = np.linspace(0.5, 3.0, n), np.linspace(1.0, 2.0, n)
+
+    def exact(j):
+        return x0[j] * np.exp(-k[j] * res.time) + (1 - np.exp(-k[j] * res.time)) / k[j]
+
+    assert np.max(np.abs(res["x[1]"] - exact(0))) < 1e-8
+    assert np.max(np.abs(res[f"x[{n}]"] - exact(n - 1))) < 1e-8
+    assert np.max(np.abs(res["y[500]"] - 2 * exact(499))) < 1e-8
+    assert np.max(np.abs(res["s"] - exact(0) - exact(n - 1))) < 1e-8
+    assert res.units["x[1]"] == "m" and res.meta["solver"] == "cvodes"
+    _same_dae(compiled.dae, _compile(Decays(n), None).dae)
+
+
+def test_the_scalar_structures_are_made_on_first_use():
+    compiled = bg.compile(RCLadderVector(1200))
+    assert isinstance(compiled, ArrayCompiledModel)
+    assert "flat" not in compiled.__dict__ and "scalar_structures" not in compiled.timings
+    bg.simulate(compiled, stop_time=0.01)                # simulation does not need them
+    assert "flat" not in compiled.__dict__
+    before = compiled.dae
+    summary = compiled.summary()                          # `check` does
+    assert summary["equations"] == 2400 and len(summary["states"]) == 1200
+    assert compiled.timings["scalar_structures"] > 0
+    assert compiled.dae is not before and compiled.dae.names == before.names
+    assert len(compiled.flat.variables) == 3600
+
+
+def test_parameters_and_results_work_as_for_any_model():
+    compiled = bg.compile(RCLadderVector(1100))
+    res = bg.simulate(compiled, stop_time=0.05, interval=0.01, params={"V": 2.0, "R[1]": 0.5},
+                      outputs=["v[1]", "i[1]"], **TIGHT)
+    ref = bg.simulate(_compile(RCLadderVector(1100), None), stop_time=0.05, interval=0.01,
+                      params={"V": 2.0, "R[1]": 0.5}, outputs=["v[1]", "i[1]"], **TIGHT)
+    for name in ("v[1]", "i[1]"):
+        assert np.max(np.abs(res[name] - ref[name])) < 1e-12
+    assert res.parameters["R[1]"] == 0.5 and res.units["i[1]"] == "A"
+
+
+def test_a_compiled_model_pickles_with_its_scalar_structures():
+    from bgmodelica.studies.payload import pickle_compiled, unpickle_compiled
+
+    back = unpickle_compiled(pickle_compiled(bg.compile(RCLadderVector(1000))))
+    assert back.source is None and len(back.flat.variables) == 3000
+    res = bg.simulate(back, stop_time=0.01, outputs=["v[1]"])
+    assert np.isfinite(res["v[1]"]).all()
+
+
+# -- what goes the scalar way ------------------------------------------------------------------
+
+class Recurrence(Component):
+    """``y[1] = u``, ``y[k+1] = y[k] + x[k+1]``, ``der(x) = -x``: a running sum (each
+    ``y[k]`` depends on the one before in the same block)."""
+
+    x = Variable(shape="n", start=1.0, fixed=True)
+    y = Variable(shape="n")
+    u = Parameter(1.0)
+
+    def __init__(self, n: int = 4, **modifiers):
+        self.n = n
+        super().__init__(**modifiers)
+
+    def equations(self):
+        yield der(self.x) == -self.x
+        yield self.y[0] == self.u
+        yield self.y[1:] == self.y[:-1] + self.x[1:]
+
+
+class Loop(Component):
+    """``a + b = 2 x``, ``a - b = 0`` element by element (a 2x2 algebraic loop per element),
+    ``der(x) = -a``: ``a = b = x``."""
+
+    x = Variable(shape="n", start=1.0, fixed=True)
+    a = Variable(shape="n")
+    b = Variable(shape="n")
+
+    def __init__(self, n: int = 4, **modifiers):
+        self.n = n
+        super().__init__(**modifiers)
+
+    def equations(self):
+        yield self.a + self.b == 2.0 * self.x
+        yield self.a - self.b == 0.0 * self.x
+        yield der(self.x) == -self.a
+
+
+def test_a_recurrence_goes_the_scalar_way_and_is_right():
+    model = Recurrence(1000)
+    assert "own block" in why_not(model)
+    res = bg.simulate(model, stop_time=1.0, interval=0.5, **TIGHT, outputs=["y[1000]"])
+    assert res["y[1000]"][-1] == pytest.approx(1.0 + 999 * np.exp(-1.0), rel=1e-8)
+
+
+def test_an_algebraic_loop_goes_the_scalar_way_and_is_right():
+    model = Loop(1000)
+    assert "loop" in why_not(model)
+    res = bg.simulate(model, stop_time=1.0, interval=0.5, **TIGHT, outputs=["x[7]"])
+    assert abs(res["x[7]"][-1] - np.exp(-1.0)) < 1e-8
+
+
+class Unbalanced(DecayDeclarations):
+    """:class:`Decays` without the equation of ``s``."""
+
+    def equations(self):
+        yield der(self.x) == -self.rate * self.x + self.u
+        yield self.y == 2.0 * self.x
+
+
+def test_an_unbalanced_model_gets_the_scalar_pipelines_error():
+    assert "equations for" in why_not(Unbalanced(1000))
+    with pytest.raises(UnbalancedModelError, match="2000 equations for 2001 unknowns"):
+        bg.compile(Unbalanced(1000))
+
+
+class WrongUnits(DecayDeclarations):
+    def equations(self):
+        yield der(self.x) == -self.rate * self.x + self.u
+        yield self.y == 2.0 * self.rate                       # 1/s where m is declared
+        yield self.s == self.x[0] + self.x[-1]
+
+
+def test_units_are_checked_on_the_array_path():
+    with pytest.raises(UnitError, match="top level"):
+        bg.compile(WrongUnits(1000))
+    assert isinstance(bg.compile(WrongUnits(1000), units="off"), ArrayCompiledModel)
+
+
+def test_other_models_say_why_they_go_the_scalar_way():
+    assert why_not(RCLadder(3)) == "it has subcomponents"
+    assert why_not(Decays(10)) == "small"
+    assert why_not(Decays(10), minimum=0) is None
+    assert "state selection" in why_not(
+        Decays(10, x={"state_select": StateSelect.ALWAYS, "start": 1.0}), minimum=0)
+
+
+class Mixed(Component):
+    """Scalar equations of array elements beside array equations:
+    ``der(x) = -x/tau``, ``z = x[1] * exp(-time/tau)``."""
+
+    x = Variable(shape=3, start=[1.0, 2.0, 3.0], fixed=True)
+    z = Variable()
+    tau = Parameter(1.0, unit="s")
+
+    def equations(self):
+        yield der(self.x) == -self.x / self.tau
+        yield self.z == self.x[0] * exp(-time / self.tau)
+
+
+def test_scalar_equations_of_elements_and_time():
+    compiled = compile_arrays(Mixed(), minimum=0)
+    _same_dae(compiled.dae, _compile(Mixed(), None).dae)
+    res = bg.simulate(compiled, stop_time=1.0, interval=0.5, **TIGHT)
+    assert abs(res["z"][-1] - np.exp(-2.0)) < 1e-8
