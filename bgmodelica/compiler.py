@@ -150,6 +150,11 @@ def compile(model: Component, *, select: Selector | None = None,  # noqa: A001
     stages and ``cache_skipped`` (the seconds spent making the key) for a model whose entry
     was dropped because loading it cost more than compiling (see :mod:`bgmodelica.cache`).
 
+    Large leaf models of array equations take the array path (:mod:`bgmodelica.array_path`):
+    compiled without a Python object per scalar, into the same DAE, and not cached (the path
+    costs less than a cache load). Their scalar structures (``flat``, ``reduced``...) are made
+    when first read.
+
     The cyclic garbage collector is paused meanwhile: compilation allocates millions of
     objects that live until the end, and rescanning them costs more than it frees."""
     if select is None:

@@ -11,7 +11,7 @@ and the result is evaluated once on the SX symbols the rest of the tool works wi
 
 from __future__ import annotations
 
-from itertools import repeat
+from itertools import compress, repeat
 from operator import attrgetter
 
 import casadi as ca
@@ -43,11 +43,10 @@ def solve_blocks(low: Lowered, order: ExplicitOrder, unknown: np.ndarray) -> ca.
             return f"block {b}: an unknown's coefficient is structurally zero"
         if ca.jtimes(coefficient, low.x, seed).nnz():
             return f"block {b}: not linear in its unknowns"
-        others = np.ones(n, dtype=bool)
-        others[mine] = False
-        zeroed = ca.project(low.x, _column(n, np.flatnonzero(others)))
-        solution = ca.substitute(-ca.substitute(r, low.x, zeroed) / coefficient, low.x,
-                                 current)
+        # -r/coefficient with the block's own unknowns read as 0: they still are symbols
+        # of x here, which :func:`assemble` evaluates with structural zeros in place of
+        # every unknown, so their terms drop out exactly
+        solution = ca.substitute(-r / coefficient, low.x, current)
         current = ca.MX(current)
         current[mine.tolist()] = solution
     return current
@@ -68,7 +67,9 @@ def assemble(col: Collected, low: Lowered, solved: ca.MX, states: np.ndarray) ->
     column = ca.SX.sym("v", n_x + n_p)
     x, p = column[:n_x], column[n_x:]
     state_list = states.tolist()
-    x_in = ca.SX(ca.Sparsity(n, 1, [0, n_x], state_list), x)   # the others are solved
+    # the unknowns are structural zeros: a block's solution reads its own as 0 (see
+    # solve_blocks), and every other was replaced by its solution
+    x_in = ca.SX(ca.Sparsity(n, 1, [0, n_x], state_list), x)
     derivatives = [j + 1 for j in state_list]                   # der(x) follows x
     f = ca.Function("array_path", [low.x, low.p, low.t], [solved[derivatives], solved])
     ode, observed = f(x_in, p, TIME.sx)
@@ -76,6 +77,9 @@ def assemble(col: Collected, low: Lowered, solved: ca.MX, states: np.ndarray) ->
         both = ca.cse(ca.vertcat(ode, observed))
         ode, observed = both[:n_x], both[n_x:]
     names = list(map(_NAME, order))
+    decls = list(map(_DECL, order))
+    fixed = [(k, float(decls[k].start))
+             for k in compress(range(n), map(attrgetter("fixed"), decls))]
     parameters = list(map(FlatVariable, map(_NAME, col.params), repeat(None),
                           map(_DECL, col.params), repeat(""), repeat(-1), repeat(-1),
                           zip(repeat(column), range(n_x, n_x + n_p))))
@@ -84,8 +88,8 @@ def assemble(col: Collected, low: Lowered, solved: ca.MX, states: np.ndarray) ->
         t=TIME.sx, ode=ode, alg=ca.SX(0, 1), observed=observed,
         names=names, state_names=[names[j] for j in state_list], algebraic_names=[],
         parameters=parameters, inputs=[],
-        x_start=np.array([float(order[j].decl.start) for j in state_list], dtype=float),
-        z_start=np.zeros(0), fixed=[(k, float(s.decl.start)) for k, s in enumerate(order)
-                                    if s.der_of is None and s.decl.fixed],
+        x_start=np.fromiter(map(attrgetter("start"), map(decls.__getitem__, state_list)),
+                            float, n_x),
+        z_start=np.zeros(0), fixed=fixed,
         observed_index=dict(zip(names, range(n), strict=True)), n_variables=n,
         differentiated={names[j] for j in state_list})

@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from itertools import compress
-from operator import attrgetter
+from itertools import compress, repeat
+from operator import attrgetter, is_not
 from typing import Any
 
 import numpy as np
@@ -110,10 +110,15 @@ def collect(model: Any, minimum: int | None = None) -> Collected | str:
     if n_rows < minimum:
         return "small"
     # columns: each variable, then its derivative if the equations made one
-    has_der = np.fromiter((s.der is not None for s in variables), bool, len(variables))
+    ders = list(map(attrgetter("der"), variables))
+    has_der = np.fromiter(map(is_not, ders, repeat(None)), bool, len(ders))
     var_col = np.arange(len(variables)) + np.cumsum(has_der) - has_der
     n = len(variables) + int(has_der.sum())
-    order = _interleave(variables, has_der, var_col, n)
+    ders = list(compress(ders, has_der))
+    slots = np.empty(n, dtype=object)
+    slots[var_col] = variables
+    slots[var_col[has_der] + 1] = ders
+    order = slots.tolist()
     column = np.empty(len(symbols), dtype=np.int64)
     column[is_var] = var_col
     column[~is_var] = n + np.arange(len(params))
@@ -131,23 +136,9 @@ def collect(model: Any, minimum: int | None = None) -> Collected | str:
         memo[id(root)] = (root, column[start:start + size])
     for k in np.flatnonzero(~in_array).tolist():
         pos[id(symbols[k])] = int(column[k])
-    der_of = compress(variables, has_der)
-    pos.update(zip(map(id, map(attrgetter("der"), der_of)), (var_col[has_der] + 1).tolist(),
-                   strict=True))
+    pos.update(zip(map(id, ders), (var_col[has_der] + 1).tolist(), strict=True))
     pos[id(TIME)] = n + len(params)
     return Collected(name, where, order, params, equations, n_rows, pos, memo)
-
-
-def _interleave(variables: list[Any], has_der: np.ndarray, var_col: np.ndarray,
-                n: int) -> list[Any]:
-    """The variables at ``var_col`` and their derivatives right after them, in one list."""
-    out: list[Any] = [None] * n
-    for k, s in zip(var_col.tolist(), variables, strict=True):
-        out[k] = s
-    for k, s in zip((var_col[has_der] + 1).tolist(), compress(variables, has_der),
-                    strict=True):
-        out[k] = s.der
-    return out
 
 
 _ELEMENT = re.compile(r"^(.*)\[([0-9,]+)\]$")
