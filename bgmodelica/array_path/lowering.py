@@ -62,7 +62,7 @@ class Lowered:
         if isinstance(x, ArrayExpr):
             if x.node is None:
                 idx = np.asarray(_rows(x.items, self.pos, self.memo), dtype=np.int64)
-                col, maps = self.all[idx.tolist()], [idx]
+                col, maps = self._take(idx), [idx]
             else:
                 op, args = x.node
                 parts = [self.lower(a, x.shape) for a in args]
@@ -82,6 +82,15 @@ class Lowered:
             out = self._scalar(x, leaves)
             return out, [np.array([k], dtype=np.int64) for k in leaves]
         return float(x), []
+
+    def _take(self, idx: np.ndarray) -> ca.MX:
+        """The columns ``idx``: a slice when they are evenly spaced (most are: slices of
+        declared arrays), a list of indices otherwise."""
+        if idx.size > 1:
+            step = int(idx[1] - idx[0])
+            if step > 0 and (np.diff(idx) == step).all():
+                return self.all[int(idx[0]):int(idx[-1]) + 1:step]
+        return self.all[idx.tolist()]
 
     def _scalar(self, e: Any, leaves: list[int]) -> Any:
         """A scalar expression tree as MX (its leaves' columns appended to ``leaves``)."""

@@ -24,6 +24,7 @@ connectors elementwise (a single connector is broadcast).
 from __future__ import annotations
 
 import re
+import weakref
 from collections.abc import Iterator
 from typing import Any
 
@@ -35,6 +36,22 @@ from .expr import ArrayBase, Equation, Expr, Leaf, Number, to_text
 #: math functions that stay whole-array operations (``sin(arr)``)
 LAZY_FUNCTIONS = frozenset({"sin", "cos", "tan", "exp", "log", "sqrt", "asin", "acos", "atan",
                             "sinh", "cosh", "tanh", "fabs", "sign"})
+
+
+#: arrays of declared scalars known to share one unit (a declared array, the derivatives of
+#: one), by the id of their numpy array of leaves: the unit check then reads one element
+_ONE_UNIT: weakref.WeakValueDictionary[int, np.ndarray] = weakref.WeakValueDictionary()
+
+
+def mark_one_unit(items: np.ndarray) -> None:
+    """Record that all leaves of ``items`` (a numpy array owning its data) share one unit."""
+    _ONE_UNIT[id(items)] = items
+
+
+def has_one_unit(items: np.ndarray) -> bool:
+    """Whether ``items``, or the array it is a view of, was marked by :func:`mark_one_unit`."""
+    base = items.base if isinstance(items.base, np.ndarray) else items
+    return _ONE_UNIT.get(id(base)) is base
 
 
 def element_names(name: str, shape: tuple[int, ...]) -> list[str]:

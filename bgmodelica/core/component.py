@@ -39,6 +39,7 @@ from .arrays import (
     connect_arrays,
     element_names,
     element_values,
+    mark_one_unit,
     normalize_shape,
 )
 from .expr import Expr, Leaf
@@ -150,12 +151,14 @@ class Element:
         symbols = self._symbols
         numeric = isinstance(modifier, (int, float)) or (
             isinstance(modifier, np.ndarray) and modifier.dtype.kind in "biuf")
-        for name, elem in zip(names, element_declarations(scalar, len(names), per_field, mods,
-                                                          numeric), strict=True):
+        decls = element_declarations(scalar, len(names), per_field, mods, numeric)
+        for name, elem in zip(names, decls, strict=True):
             sym = symbols[name] = Symbol(name, elem, self)
             leaves.append(sym.leaf)
         items = np.empty(len(leaves), dtype=object)
         items[:] = leaves
+        if mods is None or numeric or len({d.unit for d in decls}) == 1:
+            mark_one_unit(items)
         self.__dict__.setdefault("_arrays", {})[key] = shape
         object.__setattr__(self, key, ArrayExpr(items.reshape(shape)))
 

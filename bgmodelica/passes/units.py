@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.arrays import ArrayEquation, ArrayExpr, array_text
+from ..core.arrays import ArrayEquation, ArrayExpr, array_text, has_one_unit
 from ..core.expr import Equation, Expr, Leaf, Number, Op, to_text
 from ..core.flatmodel import EquationSources, FlatModel
 from ..core.hybrid import Reinit, SampleClock
@@ -473,7 +473,7 @@ def _first(x: Any, one_unit: dict[int, tuple[Any, bool]]) -> Any:
             items = x.items
             base = items.base if isinstance(items.base, np.ndarray) else items
             if id(base) not in one_unit:
-                one_unit[id(base)] = (base, _single_unit(base))
+                one_unit[id(base)] = (base, has_one_unit(base) or _single_unit(base))
             if not (one_unit[id(base)][1] or _single_unit(items)):
                 raise _Varies
             return items.flat[0]

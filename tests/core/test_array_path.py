@@ -257,3 +257,25 @@ def test_scalar_equations_of_elements_and_time():
     _same_dae(compiled.dae, _compile(Mixed(), None).dae)
     res = bg.simulate(compiled, stop_time=1.0, interval=0.5, **TIGHT)
     assert abs(res["z"][-1] - np.exp(-2.0)) < 1e-8
+
+
+class TwoUnits(Component):
+    """``x[1]`` in m, ``x[2]`` in s (per-element modifiers), ``y`` all in m: ``y == x`` holds
+    for the first element only."""
+
+    x = Variable(shape=2, unit="m")
+    y = Variable(shape=2, unit="m")
+    tau = Parameter(1.0, unit="s")
+
+    def equations(self):
+        yield der(self.x) == -self.x / self.tau
+        yield self.y == 3.0 * self.x
+
+
+def test_an_array_of_several_units_is_checked_element_by_element():
+    model = TwoUnits(x=[{"unit": "m", "start": 1.0}, {"unit": "s", "start": 2.0}])
+    with pytest.raises(UnitError, match="y"):
+        compile_arrays(model, minimum=0)
+    with pytest.raises(UnitError):
+        bg.compile(TwoUnits(x=[{"unit": "m", "start": 1.0}, {"unit": "s", "start": 2.0}]))
+    assert isinstance(compile_arrays(TwoUnits(), minimum=0), ArrayCompiledModel)
