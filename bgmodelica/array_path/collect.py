@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from itertools import compress, repeat
+from itertools import chain, compress, repeat
 from operator import attrgetter, is_not
 from typing import Any
 
@@ -66,18 +66,22 @@ def collect(model: Any, minimum: int | None = None) -> Collected | str:
     if "_mo_env" in type(model).__dict__:
         return "a Modelica class"
     symbols = list(model._symbols.values())
-    decls = list(map(_DECL, symbols))
-    is_var = np.fromiter(map(Variable.__instancecheck__, decls), bool, len(decls))
-    kinds = set(map(type, decls))
-    if not kinds <= {Variable, Parameter}:
-        bad = next(d for d in decls if type(d) not in (Variable, Parameter))
-        return f"a {type(bad).__name__} is declared"
-    variables = list(compress(symbols, is_var))
-    params = list(compress(symbols, ~is_var))
-    var_decls = list(compress(decls, is_var))
-    if set(map(attrgetter("state_select"), var_decls)) - {StateSelect.DEFAULT}:
+    names = list(model._symbols)
+    runs = _runs(model, names)
+    # the elements of a declared array share their declaration's class
+    is_var_run = []
+    for start, _, _ in runs:
+        kind = type(symbols[start].decl)
+        if kind not in (Variable, Parameter):
+            return f"{symbols[start].name} is a {kind.__name__}"
+        is_var_run.append(kind is Variable)
+    variables = list(chain.from_iterable(symbols[a:a + n] for (a, n, _), v in
+                                         zip(runs, is_var_run, strict=True) if v))
+    params = list(chain.from_iterable(symbols[a:a + n] for (a, n, _), v in
+                                      zip(runs, is_var_run, strict=True) if not v))
+    if set(map(attrgetter("state_select"), map(_DECL, variables))) - {StateSelect.DEFAULT}:
         return "a variable has a state selection"
-    if set(map(type, map(attrgetter("value"), compress(decls, ~is_var)))) - {float, int}:
+    if set(map(type, map(attrgetter("value"), map(_DECL, params)))) - {float, int}:
         return "a parameter is not given as a number"
     if _own_methods(type(model), "initial_equations") != (Component.initial_equations,) \
             or model.__dict__.get("_initial_equations"):
@@ -112,33 +116,51 @@ def collect(model: Any, minimum: int | None = None) -> Collected | str:
     # columns: each variable, then its derivative if the equations made one
     ders = list(map(attrgetter("der"), variables))
     has_der = np.fromiter(map(is_not, ders, repeat(None)), bool, len(ders))
+    keep = np.ones(2 * len(variables), dtype=bool)
+    keep[1::2] = has_der
+    order = list(compress(chain.from_iterable(zip(variables, ders, strict=True)),
+                          keep.tolist()))
+    n = len(order)
     var_col = np.arange(len(variables)) + np.cumsum(has_der) - has_der
-    n = len(variables) + int(has_der.sum())
     ders = list(compress(ders, has_der))
-    slots = np.empty(n, dtype=object)
-    slots[var_col] = variables
-    slots[var_col[has_der] + 1] = ders
-    order = slots.tolist()
+    sizes = np.array([size for _, size, _ in runs], dtype=np.int64)
+    is_var = np.repeat(np.array(is_var_run, dtype=bool), sizes)
     column = np.empty(len(symbols), dtype=np.int64)
     column[is_var] = var_col
     column[~is_var] = n + np.arange(len(params))
     pos, memo = _Positions(symbols, column), {}
-    in_array = np.zeros(len(symbols), dtype=bool)
-    names = list(model._symbols)
+    for start, _, array in runs:
+        if not array:
+            pos[id(symbols[start])] = int(column[start])
     for key, shape in model.__dict__.get("_arrays", {}).items():
-        start = names.index(f"{key}[{','.join(['1'] * len(shape))}]")
-        size = int(np.prod(shape))
+        start = names.index(_first_element(key, shape))
         pos.arrays[key] = (start, shape)
-        in_array[start:start + size] = True
         root = getattr(model, key).items
         while isinstance(root.base, np.ndarray):
             root = root.base
-        memo[id(root)] = (root, column[start:start + size])
-    for k in np.flatnonzero(~in_array).tolist():
-        pos[id(symbols[k])] = int(column[k])
+        memo[id(root)] = (root, column[start:start + int(np.prod(shape))])
     pos.update(zip(map(id, ders), (var_col[has_der] + 1).tolist(), strict=True))
     pos[id(TIME)] = n + len(params)
     return Collected(name, where, order, params, equations, n_rows, pos, memo)
+
+
+def _first_element(key: str, shape: tuple[int, ...]) -> str:
+    return f"{key}[{','.join(['1'] * len(shape))}]"
+
+
+def _runs(model: Any, names: list[str]) -> list[tuple[int, int, bool]]:
+    """``(start, size, is_array)`` of each declaration in ``names`` (the model's symbols in
+    order): a declared array is one run of its elements, a scalar a run of one."""
+    arrays = sorted((names.index(_first_element(key, shape)), int(np.prod(shape)))
+                    for key, shape in model.__dict__.get("_arrays", {}).items())
+    out: list[tuple[int, int, bool]] = []
+    k = 0
+    for start, size in arrays:
+        out.extend((j, 1, False) for j in range(k, start))
+        out.append((start, size, True))
+        k = start + size
+    out.extend((j, 1, False) for j in range(k, len(names)))
+    return out
 
 
 _ELEMENT = re.compile(r"^(.*)\[([0-9,]+)\]$")

@@ -39,7 +39,7 @@ from .arrays import (
     connect_arrays,
     element_names,
     element_values,
-    mark_one_unit,
+    mark_leaves,
     normalize_shape,
 )
 from .expr import Expr, Leaf
@@ -157,8 +157,7 @@ class Element:
             leaves.append(sym.leaf)
         items = np.empty(len(leaves), dtype=object)
         items[:] = leaves
-        if mods is None or numeric or len({d.unit for d in decls}) == 1:
-            mark_one_unit(items)
+        mark_leaves(items, mods is None or numeric or len({d.unit for d in decls}) == 1)
         self.__dict__.setdefault("_arrays", {})[key] = shape
         object.__setattr__(self, key, ArrayExpr(items.reshape(shape)))
 

@@ -56,7 +56,7 @@ def der(expr: Any) -> Any:
 def _leaf_rates(expr: ArrayBase) -> Any:
     """``der`` of a stored array of declared scalars (``der(v[:-1])``), element by element
     without the general differentiation; None for any other array."""
-    from .arrays import ArrayExpr, _wrap, has_one_unit, mark_one_unit
+    from .arrays import ArrayExpr, _wrap, has_one_unit, is_declared, mark_leaves
 
     if not isinstance(expr, ArrayExpr) or expr.node is not None:
         return None
@@ -65,8 +65,8 @@ def _leaf_rates(expr: ArrayBase) -> Any:
         return None
     out = np.empty(items.size, dtype=object)
     out[:] = [_rate(leaf.sym) for leaf in items.flat]
-    if out.size and isinstance(out[0], Leaf) and has_one_unit(items):
-        mark_one_unit(out)                        # derivatives of one unit: one unit
+    if out.size and is_declared(items) and isinstance(out[0], Leaf):
+        mark_leaves(out, has_one_unit(items))  # one declaration: all variables, or none
     return _wrap(out.reshape(items.shape))
 
 
