@@ -399,7 +399,7 @@ def quantity_value(name: str, value: Any, unit: str | None) -> Any:
 def declared_units(compiled: Any) -> dict[str, str]:
     """Dotted name -> declared unit of every variable, parameter, input and discrete of a
     compiled model (aliases included)."""
-    flat = compiled.reduced.model
+    flat = compiled.declarations
     out = {v.name: v.decl.unit for group in (flat.variables, flat.parameters, flat.inputs,
                                              flat.discretes) for v in group}
     for alias, (kept, _) in flat.aliases.items():

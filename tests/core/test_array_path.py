@@ -279,3 +279,10 @@ def test_an_array_of_several_units_is_checked_element_by_element():
     with pytest.raises(UnitError):
         bg.compile(TwoUnits(x=[{"unit": "m", "start": 1.0}, {"unit": "s", "start": 2.0}]))
     assert isinstance(compile_arrays(TwoUnits(), minimum=0), ArrayCompiledModel)
+
+
+def test_values_with_units_need_no_scalar_structures():
+    compiled = bg.compile(RCLadderVector(1000))
+    res = bg.simulate(compiled, stop_time=0.01, params={"V": "2000 mV"}, outputs=["v[1]"])
+    assert res.parameters["V"] == pytest.approx(2.0)
+    assert "flat" not in compiled.__dict__
