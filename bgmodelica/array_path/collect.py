@@ -55,6 +55,7 @@ class Collected:
 
 
 _DECL = attrgetter("decl")
+_NUMBERS = (int, float, np.integer, np.floating)
 
 
 def collect(model: Any, minimum: int | None = None) -> Collected | str:
@@ -81,7 +82,8 @@ def collect(model: Any, minimum: int | None = None) -> Collected | str:
                                       zip(runs, is_var_run, strict=True) if not v))
     if set(map(attrgetter("state_select"), map(_DECL, variables))) - {StateSelect.DEFAULT}:
         return "a variable has a state selection"
-    if set(map(type, map(attrgetter("value"), map(_DECL, params)))) - {float, int}:
+    if not all(issubclass(t, _NUMBERS) and t is not bool
+               for t in set(map(type, map(attrgetter("value"), map(_DECL, params))))):
         return "a parameter is not given as a number"
     if _own_methods(type(model), "initial_equations") != (Component.initial_equations,) \
             or model.__dict__.get("_initial_equations"):

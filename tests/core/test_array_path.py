@@ -286,3 +286,35 @@ def test_values_with_units_need_no_scalar_structures():
     res = bg.simulate(compiled, stop_time=0.01, params={"V": "2000 mV"}, outputs=["v[1]"])
     assert res.parameters["V"] == pytest.approx(2.0)
     assert "flat" not in compiled.__dict__
+
+
+class NumpyValues(Component):
+    """``der(x) = -a*x`` with ``a`` from a numpy array default (numpy scalars as values)."""
+
+    x = Variable(shape=3, start=1.0, fixed=True)
+    a = Parameter(shape=3, value=np.array([1.0, 2.0, 3.0]))
+
+    def equations(self):
+        yield der(self.x) == -self.a * self.x
+
+
+def test_numpy_values_take_the_array_path():
+    assert why_not(NumpyValues(), minimum=0) is None
+    res = bg.simulate(compile_arrays(NumpyValues(), minimum=0), stop_time=1.0, **TIGHT)
+    assert res["x[3]"][-1] == pytest.approx(np.exp(-3.0), rel=1e-8)
+
+
+def test_fmu_export_and_linearization_of_a_model_from_the_array_path(tmp_path):
+    from fmpy import simulate_fmu
+
+    from bgmodelica.fmi.from_model import export_model
+
+    compiled = compile_arrays(Decays(4), minimum=0)
+    fmu = export_model(compiled, tmp_path, fmi_version=2, fmu_type="cs")
+    out = simulate_fmu(str(fmu), stop_time=1.0, output=["x[4]"], output_interval=0.5)
+    k, x0 = 3.0, 2.0
+    exact = x0 * np.exp(-k) + (1 - np.exp(-k)) / k
+    assert abs(out["x[4]"][-1] - exact) < 1e-4
+    sys = bg.linearize(compile_arrays(Decays(4), minimum=0))
+    assert sorted(np.linalg.eigvals(sys.A).real) == pytest.approx(
+        sorted(-np.linspace(0.5, 3.0, 4)), rel=1e-9)
