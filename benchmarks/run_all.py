@@ -181,6 +181,7 @@ def cache_rows(cases: list[tuple[str, int]]) -> list[dict]:
     with tempfile.TemporaryDirectory(prefix="bgm_cache_") as folder:
         for form, n in cases:
             model = make[form](n)                   # constructed outside the timings
+            gc.collect()                            # not the garbage of the runs before
             t0 = time.perf_counter()
             first = compile(model, cache=folder)     # key + compile (+ store, taken out)
             if "cache_store" not in first.timings:   # the array path: nothing cached

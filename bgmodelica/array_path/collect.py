@@ -64,8 +64,6 @@ def collect(model: Any, minimum: int | None = None) -> Collected | str:
         return "not a component class"
     if model._children:
         return "it has subcomponents"
-    if "_mo_env" in type(model).__dict__:
-        return "a Modelica class"
     symbols = list(model._symbols.values())
     names = list(model._symbols)
     runs = _runs(model, names)
