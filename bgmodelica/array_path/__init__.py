@@ -65,9 +65,19 @@ def _build(model: Any, units: str, minimum: int | None) -> ArrayCompiledModel | 
     check_equations(col.equations, col.where, units)
     lap("units")
     try:
-        low = Lowered(col)
-    except KeyError:          # a symbol of another component: the scalar path says which
-        return "an equation uses a symbol that is not part of the model"
+        found = _compile_blocks(col, lap)
+    except Exception as err:  # noqa: BLE001 -- the scalar pipeline gives the precise error
+        return f"{type(err).__name__}: {err}"
+    if isinstance(found, str):
+        return found
+    return ArrayCompiledModel.made(col.name, found, col.n_rows, timings, model, units,
+                                   col.order)
+
+
+def _compile_blocks(col: Any, lap: Any) -> Any:
+    """The :class:`~bgmodelica.backends.casadi_dae.CasadiDAE` of a collected model, or why
+    its equations do not solve explicitly block by block."""
+    low = Lowered(col)
     lap("lowering")
     is_state = np.fromiter((s.der is not None for s in col.order), bool, len(col.order))
     unknown = np.flatnonzero(~is_state)
@@ -87,8 +97,7 @@ def _build(model: Any, units: str, minimum: int | None) -> ArrayCompiledModel | 
     lap("solve")
     dae = assemble(col, low, solved, np.flatnonzero(is_state))
     lap("backend")
-    return ArrayCompiledModel.made(col.name, dae, col.n_rows, timings, model, units,
-                                   col.order)
+    return dae
 
 
 class ArrayCompiledModel(CompiledModel):

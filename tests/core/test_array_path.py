@@ -318,3 +318,20 @@ def test_fmu_export_and_linearization_of_a_model_from_the_array_path(tmp_path):
     sys = bg.linearize(compile_arrays(Decays(4), minimum=0))
     assert sorted(np.linalg.eigvals(sys.A).real) == pytest.approx(
         sorted(-np.linspace(0.5, 3.0, 4)), rel=1e-9)
+
+
+def test_a_symbol_of_another_component_gets_the_scalar_pipelines_error():
+    from bgmodelica.errors import EquationError
+
+    other = Decays(1000)
+
+    class Alien(DecayDeclarations):
+        def equations(self):
+            yield der(self.x) == -self.rate * other.x + self.u
+            yield self.y == 2.0 * self.x
+            yield self.s == self.x[0] + self.x[-1]
+
+    model = Alien(1000)
+    assert "KeyError" in why_not(model)
+    with pytest.raises(EquationError, match="not part of the model"):
+        bg.compile(Alien(1000))
