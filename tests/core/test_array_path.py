@@ -12,39 +12,9 @@ from bgmodelica import Component, Parameter, StateSelect, Variable, der, exp, ti
 from bgmodelica.array_path import ArrayCompiledModel, compile_arrays, why_not
 from bgmodelica.compiler import _compile
 from bgmodelica.errors import UnbalancedModelError, UnitError
-from bgmodelica.structure.explicit_order import explicit_order
 from library.examples import RCLadder, RCLadderVector
 
 TIGHT = {"rtol": 1e-10, "atol": 1e-12}
-
-
-# -- the integer part --------------------------------------------------------------------------
-
-def test_a_triangular_chain_is_ordered_block_after_block():
-    # block 0: e0 uses u0; block 1: e1 uses u0, u1 and e2 uses u0, u2; block 2: e3 uses u1, u3
-    rows = np.array([0, 1, 1, 2, 2, 3, 3])
-    cols = np.array([0, 0, 1, 0, 2, 1, 3])
-    order = explicit_order(4, rows, cols, [1, 2, 1])
-    assert not isinstance(order, str)
-    assert order.unknown_of.tolist() == [0, 1, 2, 3]
-    assert order.blocks == [0, 1, 2]
-
-
-def test_blocks_written_out_of_order_are_sorted():
-    # block 0 uses what block 1 solves
-    order = explicit_order(2, np.array([0, 0, 1]), np.array([0, 1, 1]), [1, 1])
-    assert order.blocks == [1, 0]
-
-
-@pytest.mark.parametrize(("rows", "cols", "sizes", "why"), [
-    ([0, 1], [0, 0], [1, 1], "no perfect matching"),
-    ([0, 0, 1, 1], [0, 1, 0, 1], [1, 1], "algebraic loop"),
-    ([0, 1, 1], [0, 0, 1], [2], "own block"),                 # a recurrence u1 = f(u0)
-    ([0, 0, 1, 1, 2, 2, 3], [0, 3, 1, 2, 2, 0, 3], [2, 1, 1], "cycle"),
-])
-def test_systems_that_do_not_solve_explicitly_say_why(rows, cols, sizes, why):
-    found = explicit_order(sum(sizes), np.array(rows), np.array(cols), sizes)
-    assert isinstance(found, str) and why in found
 
 
 # -- the same DAE as the scalar pipeline -------------------------------------------------------
