@@ -1,22 +1,29 @@
-"""Multi-domain example: a DC motor whose winding heats up (electrical + rotational + thermal).
+"""Thermal examples: a DC motor whose winding heats up (electrical + rotational + thermal),
+and heat conduction along a rod discretized with array equations.
 
 :class:`ThermalDCMotor`: the :class:`~library.examples.motors.DCMotor` drive with a
 temperature-dependent armature resistance (:class:`~library.thermal.HeatingResistor`) whose
 copper losses heat the winding (:class:`~library.thermal.HeatCapacitor`), cooled to the
 ambient through a :class:`~library.thermal.ThermalConductor`. :func:`steady_state` gives its
 analytic fixed point.
+
+:class:`HeatRod`: the heat equation on a rod with both ends held at a fixed temperature, as
+``n`` nodes and array equations (large ``n`` compiles by the array path); its sine mode decays
+exactly as :func:`rod_mode` says.
 """
 
 from __future__ import annotations
 
 import math
 
-from bgmodelica import Component, connect
+import numpy as np
+
+from bgmodelica import Component, Parameter, Variable, connect, der
 from library.electrical import EMF, ConstantVoltage, Ground, Inductor
 from library.rotational import Damper, Fixed, Inertia
 from library.thermal import FixedTemperature, HeatCapacitor, HeatingResistor, ThermalConductor
 
-__all__ = ["ThermalDCMotor", "steady_state"]
+__all__ = ["HeatRod", "ThermalDCMotor", "rod_mode", "steady_state"]
 
 
 class ThermalDCMotor(Component):
@@ -90,3 +97,49 @@ def steady_state(V: float = 12.0, R_ref: float = 1.0, T_ref: float = 293.15,
     if not math.isfinite(T):
         raise ArithmeticError("no steady state (thermal runaway)")
     return {"T": T, "R": R, "i": i, "w": k * i / d, "P": R * i * i}
+
+
+class HeatRod(Component):
+    """Heat conduction along a rod of length ``L`` whose ends are held at ``T_end``: the
+    heat equation ``dT/dt = alpha d2T/dx2`` on ``n`` interior nodes ``x_k = k h``,
+    ``h = L/(n + 1)`` (second-order central differences, written as array equations)::
+
+        der(T[1])     = c (T_end - 2 T[1] + T[2])
+        der(T[2:n-1]) = c (T[1:n-2] - 2 T[2:n-1] + T[3:n])
+        der(T[n])     = c (T[n-1] - 2 T[n] + T_end)          c = alpha / h^2
+
+    Parameters: ``alpha`` thermal diffusivity [m2/s] (1e-4), ``L`` [m] (0.1), ``T_end`` [K]
+    (300). States: ``T[1..n]`` [K], starting at ``T_end + A sin(pi x_k / L)`` (``A`` = 10 K,
+    the constructor's ``amplitude``), the rod's slowest mode, which then decays exactly as
+    :func:`rod_mode`.
+    """
+
+    T = Variable(shape="n", unit="K", description="node temperature")
+    alpha = Parameter(1e-4, unit="m2/s", description="thermal diffusivity")
+    L = Parameter(0.1, unit="m", description="rod length")
+    T_end = Parameter(300.0, unit="K", description="temperature held at both ends")
+
+    def __init__(self, n: int = 10, amplitude: float = 10.0, **modifiers):
+        if n < 3:
+            raise ValueError("HeatRod needs n >= 3 nodes")
+        self.n = n
+        x = np.arange(1, n + 1) / (n + 1)
+        super().__init__(**{"T": 300.0 + amplitude * np.sin(np.pi * x), **modifiers})
+
+    def equations(self):
+        T = self.T
+        c = self.alpha * (self.n + 1) ** 2 / self.L**2
+        yield der(T[0]) == c * (self.T_end - 2.0 * T[0] + T[1])
+        yield der(T[1:-1]) == c * (T[:-2] - 2.0 * T[1:-1] + T[2:])
+        yield der(T[-1]) == c * (T[-2] - 2.0 * T[-1] + self.T_end)
+
+
+def rod_mode(n: int, t: float, alpha: float = 1e-4, L: float = 0.1, T_end: float = 300.0,
+             amplitude: float = 10.0) -> np.ndarray:
+    """The node temperatures of :class:`HeatRod` at time ``t`` [s]: its start profile is an
+    eigenvector of the discrete Laplacian, so ``T_k(t) = T_end + A e^(lambda t)
+    sin(pi x_k / L)`` with ``lambda = -(4 alpha / h^2) sin^2(pi h / (2 L))`` exactly."""
+    h = L / (n + 1)
+    lam = -4.0 * alpha / h**2 * math.sin(math.pi * h / (2.0 * L)) ** 2
+    x = np.arange(1, n + 1) / (n + 1)
+    return T_end + amplitude * math.exp(lam * t) * np.sin(np.pi * x)

@@ -305,3 +305,18 @@ def test_a_symbol_of_another_component_gets_the_scalar_pipelines_error():
     assert "KeyError" in why_not(model)
     with pytest.raises(EquationError, match="not part of the model"):
         bg.compile(Alien(1000))
+
+
+def test_a_heat_rod_of_1000_nodes_takes_the_array_path_and_decays_exactly():
+    from library.examples.thermal import HeatRod, rod_mode
+
+    n = 1000
+    assert why_not(HeatRod(n)) is None
+    res = bg.simulate(HeatRod(n), stop_time=5.0, interval=2.5, rtol=1e-9, atol=1e-9,
+                      outputs=["T[1]", "T[500]", f"T[{n}]"])
+    assert isinstance(res.meta["timings"], dict) and "lowering" in res.meta["timings"]
+    exact = rod_mode(n, 5.0)
+    for k in (1, 500, n):
+        assert abs(res[f"T[{k}]"][-1] - exact[k - 1]) < 1e-6
+    assert abs(res["T[500]"][-1] - res["T[500]"][0]) > 3.0        # it did decay
+    _same_dae(compile_arrays(HeatRod(5), minimum=0).dae, _compile(HeatRod(5), None).dae)
