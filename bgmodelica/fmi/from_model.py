@@ -81,6 +81,7 @@ def fmu_spec(model: Component | CompiledModel, *, stop_time: float = 1.0,
     degenerates. ``static_states=True`` exports it anyway, for motions known to stay where the
     compiled states are valid."""
     compiled = model if isinstance(model, CompiledModel) else compile(model)
+    flat = compiled.reduced.model        # first: a model from the array path completes here
     dae = compiled.dae
     hybrid = dae.hybrid is not None      # events: see bgmodelica.fmi.hybrid
     if hybrid:
@@ -95,7 +96,6 @@ def fmu_spec(model: Component | CompiledModel, *, stop_time: float = 1.0,
             "wrong when they degenerate. Give states valid everywhere with state_select, or "
             "export with static_states=True (--static-states) if the motion stays where "
             "they are valid")
-    flat = compiled.reduced.model
     n_par = len(dae.parameters)
     p_all = dae.p_default
     if hybrid:

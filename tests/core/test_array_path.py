@@ -281,6 +281,7 @@ def test_fmu_export_and_linearization_of_a_model_from_the_array_path(tmp_path):
 
     compiled = compile_arrays(Decays(4), minimum=0)
     fmu = export_model(compiled, tmp_path, fmi_version=2, fmu_type="cs")
+    assert "flat" in compiled.__dict__           # export completed the scalar structures
     out = simulate_fmu(str(fmu), stop_time=1.0, output=["x[4]"], output_interval=0.5)
     k, x0 = 3.0, 2.0
     exact = x0 * np.exp(-k) + (1 - np.exp(-k)) / k
