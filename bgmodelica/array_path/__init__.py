@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from ..compiler import CompiledModel
+from ..errors import ModelError
 from ..structure.explicit_order import explicit_order
 from .build import assemble, solve_blocks
 from .collect import ARRAY_PATH_FROM, collect
@@ -133,9 +134,11 @@ class ArrayCompiledModel(CompiledModel):
             full = _compile(self.source, None, self.__dict__.get("_units", "error"))
         mine, theirs = self.dae, full.dae
         if (mine.names != theirs.names or mine.state_names != theirs.state_names
-                or [q.name for q in mine.parameters] != [q.name for q in theirs.parameters]):
-            raise RuntimeError(f"{self.name}: the array path and the scalar pipeline made "
-                               "different models (please report this)")
+                or [q.name for q in mine.parameters] != [q.name for q in theirs.parameters]
+                or not np.array_equal(mine.p_default, theirs.p_default)
+                or not np.array_equal(mine.x_start, theirs.x_start)):
+            raise ModelError(f"{self.name}: its component no longer gives the model that was "
+                             "compiled (was it modified after compile()?); compile it again")
         for attr in _DEFERRED:
             self.__dict__[attr] = getattr(full, attr)
         self.__dict__["dae"] = theirs

@@ -321,3 +321,13 @@ def test_a_heat_rod_of_1000_nodes_takes_the_array_path_and_decays_exactly():
         assert abs(res[f"T[{k}]"][-1] - exact[k - 1]) < 1e-6
     assert abs(res["T[500]"][-1] - res["T[500]"][0]) > 3.0        # it did decay
     _same_dae(compile_arrays(HeatRod(5), minimum=0).dae, _compile(HeatRod(5), None).dae)
+
+
+def test_a_component_changed_after_compile_is_refused_when_completing():
+    from bgmodelica.errors import ModelError
+
+    model = RCLadderVector(1000)
+    compiled = bg.compile(model)
+    model.modify(V=5.0)
+    with pytest.raises(ModelError, match="modified after compile"):
+        compiled.summary()
