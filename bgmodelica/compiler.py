@@ -136,7 +136,8 @@ class CompiledModel:
 
 
 def compile(model: Component, *, select: Selector | None = None,  # noqa: A001
-            units: str = "error", cache: bool | str | Path = False) -> CompiledModel:
+            units: str = "error", cache: bool | str | Path = False,
+            array_path: bool = True) -> CompiledModel:
     """Compile a component tree into a :class:`CompiledModel`.
 
     units: dimensional analysis of every equation (:mod:`bgmodelica.passes.units`):
@@ -153,11 +154,11 @@ def compile(model: Component, *, select: Selector | None = None,  # noqa: A001
     Large leaf models of array equations take the array path (:mod:`bgmodelica.array_path`):
     compiled without a Python object per scalar, into the same DAE, and not cached (the path
     costs less than a cache load). Their scalar structures (``flat``, ``reduced``...) are made
-    when first read.
+    when first read. ``array_path=False`` sends every model through the scalar pipeline.
 
     The cyclic garbage collector is paused meanwhile: compilation allocates millions of
     objects that live until the end, and rescanning them costs more than it frees."""
-    if select is None:
+    if select is None and array_path:
         from .array_path import compile_arrays
 
         with gc_paused():

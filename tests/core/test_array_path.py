@@ -331,3 +331,9 @@ def test_a_component_changed_after_compile_is_refused_when_completing():
     model.modify(V=5.0)
     with pytest.raises(ModelError, match="modified after compile"):
         compiled.summary()
+
+
+def test_the_array_path_can_be_turned_off():
+    compiled = bg.compile(RCLadderVector(1000), array_path=False)
+    assert not isinstance(compiled, ArrayCompiledModel) and "flatten" in compiled.timings
+    _same_dae(bg.compile(RCLadderVector(1000)).dae, compiled.dae)
