@@ -372,6 +372,8 @@ def array_text(x: Any) -> str:
             items = list(x.items.flat)
             if items and all(isinstance(i, Leaf) for i in items):
                 parts = compact_names([to_text(i) for i in items])
+                if len(set(parts)) == 1:       # the same name in each element of a group
+                    return parts[0]
             else:
                 parts = [to_text(i) for i in items[:3]] + (["..."] if len(items) > 3 else [])
             return parts[0] if len(parts) == 1 else "{" + ", ".join(parts) + "}"

@@ -114,7 +114,8 @@ class EquationSources:
     :class:`~bgmodelica.core.flatten_hybrid.HybridDraft` or None. bindings: parameters bound to
     expressions ``(dotted name, declaration, origin)``. links: connected signals ``(a, b,
     origin)``. initial: initial equations ``(Equation, origin)``. arrays: array equations
-    lowered as blocks ``(ArrayEquation, origin)``.
+    lowered as blocks ``(ArrayEquation, origin)`` or ``(ArrayEquation, origin, origins)``
+    with the origin of each element (a group of components written once).
     """
 
     groups: dict[Any, list] = field(default_factory=dict)
@@ -122,7 +123,7 @@ class EquationSources:
     bindings: list[tuple[str, Any, str]] = field(default_factory=list)
     links: list[tuple[Any, Any, str]] = field(default_factory=list)
     initial: list[tuple[Any, str]] = field(default_factory=list)
-    arrays: list[tuple[Any, str]] = field(default_factory=list)
+    arrays: list[tuple[Any, ...]] = field(default_factory=list)
 
 
 #: per-model memos kept in ``FlatModel.__dict__`` (not pickled)

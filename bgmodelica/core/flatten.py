@@ -200,8 +200,9 @@ class _Flattener(ConnectionLowering):
                     if isinstance(p.decl.value, Expr)]
         links = [(c.a, c.b, self.where(ctx)) for c, ctx in self.connections
                  if not isinstance(c.a, Connector)]
+        blocks = [(eq, where, self.row_origins.get(id(eq))) for eq, where in self.blocks]
         return EquationSources(self.groups, self.draft, bindings, links, self.initial_sources,
-                               self.blocks)
+                               blocks)
 
     @property
     def full(self) -> dict[int, str]:

@@ -20,12 +20,13 @@ differs between elements, an ``if`` on a variable, an event, a ``connect``) make
 from __future__ import annotations
 
 import inspect
+from operator import attrgetter
 from types import FunctionType, MethodType
 from typing import Any
 
 import numpy as np
 
-from .arrays import ArrayEquation, ArrayExpr
+from .arrays import ArrayEquation, ArrayExpr, mark_leaves
 from .component import Component, Connector, _own_methods
 from .expr import Leaf
 
@@ -35,6 +36,9 @@ _PLAIN = (bool, int, float, str, type(None))
 
 class _Varies(Exception):
     """The elements differ in something the equations read: flatten them one by one."""
+
+
+_SYM, _DECL, _UNIT = attrgetter("sym"), attrgetter("decl"), attrgetter("unit")
 
 
 class _View:
@@ -70,6 +74,9 @@ class _View:
                 raise _Varies(name)
             arr = np.empty(len(values), dtype=object)
             arr[:] = values
+            decls = list(map(_DECL, map(_SYM, values)))
+            mark_leaves(arr, len(set(zip(map(type, decls), map(_UNIT, decls),
+                                         strict=True))) == 1)
             return ArrayExpr(arr)
         if isinstance(first, Connector):
             return _View(values)

@@ -302,13 +302,13 @@ class _Checker:
                 self._guard(lambda w=where, e=eq: f"{w}: {to_text(e.lhs)} == {to_text(e.rhs)}",
                             lambda e=eq: self.equation(e), n)
 
-    def _arrays(self, arrays: list[tuple[Any, str]]) -> None:
+    def _arrays(self, arrays: list[tuple[Any, ...]]) -> None:
         one_unit: dict[int, tuple[Any, bool]] = {}
-        for eq, where in arrays:
+        for eq, where, *origins in arrays:
             try:
                 first = Equation(_first(eq.lhs, one_unit), _first(eq.rhs, one_unit))
-            except _Varies:
-                self._groups(_scalar_groups(eq.equations(), where))
+            except _Varies:                  # element by element, each under its origin
+                self._groups(_scalar_groups(eq.equations(), (origins or [None])[0] or where))
                 continue
             self._guard(lambda w=where, e=eq: f"{w}: {array_text(e.lhs)} == "
                                               f"{array_text(e.rhs)}",
@@ -494,12 +494,14 @@ def _single_unit(leaves: np.ndarray) -> bool:
         return False
 
 
-def _scalar_groups(equations: list[Equation], where: str) -> dict[Any, list]:
-    """Scalar equations grouped by shape, as flattening groups them."""
+def _scalar_groups(equations: list[Equation], where: str | list[str]) -> dict[Any, list]:
+    """Scalar equations grouped by shape, as flattening groups them (``where``: their
+    origin, or the origin of each)."""
     from ..core.expr import shape_of
 
     out: dict[Any, list] = {}
-    for eq in equations:
+    wheres = [where] * len(equations) if isinstance(where, str) else where
+    for eq, where in zip(equations, wheres, strict=True):
         leaves: list = []
         consts: list = []
         shape = []

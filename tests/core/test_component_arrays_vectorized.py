@@ -23,7 +23,7 @@ TIGHT = {"rtol": 1e-10, "atol": 1e-12}
 
 def blocks(model: Component) -> set[str]:
     """Origins of the groups whose equations were written once."""
-    return {where for _, where in flatten(model).sources.arrays}
+    return {entry[1] for entry in flatten(model).sources.arrays}
 
 
 def test_library_component_arrays_are_written_once():
@@ -174,3 +174,54 @@ def test_methods_static_methods_properties_and_constants_work_on_the_array():
     res = bg.simulate(Helpers(), stop_time=1.0, interval=0.5, **TIGHT)
     for k, a in enumerate((0.5, 1.0, 1.5), start=1):
         assert math.isclose(res[f"h[{k}].x"][-1], math.exp(-2.0 * a), rel_tol=1e-8)
+
+
+class Ohm(Component):
+    """``v = R*i`` with ``v`` in V, ``R`` in Ohm, ``i = I`` in A."""
+
+    v = Variable(unit="V")
+    i = Variable(unit="A")
+    R = Parameter(1.0, unit="Ohm")
+    I = Parameter(2.0, unit="A")  # noqa: E741
+
+    def equations(self):
+        yield self.i == self.I
+        yield self.v == self.R * self.i
+
+
+class OhmBank(Component):
+    def __init__(self, n: int, odd: dict | None = None):
+        super().__init__()
+        for k in range(n):
+            self.add(f"r{k}", Ohm(**({"v": odd} if odd is not None and k == n - 1 else {})))
+
+
+def test_a_unit_changed_on_one_element_of_a_group_is_checked_there():
+    from bgmodelica.errors import UnitError
+
+    bg.compile(OhmBank(GROUP_FROM + 2))                   # one unit: fine
+    with pytest.raises(UnitError, match=r"r65 \(Ohm\): v == \(R\*i\)"):
+        bg.compile(OhmBank(GROUP_FROM + 2, odd={"unit": "A"}))
+
+
+def test_a_unit_error_of_a_whole_group_reads_like_the_class_equation():
+    from bgmodelica.errors import UnitError
+
+    class Wrong(Component):
+        v = Variable(unit="V")
+        i = Variable(unit="A")
+        I = Parameter(2.0, unit="A")  # noqa: E741
+
+        def equations(self):
+            yield self.i == self.I
+            yield self.v == self.i                            # A where V is declared
+
+    class WrongBank(Component):
+        def __init__(self, n):
+            super().__init__()
+            for k in range(n):
+                self.add(f"r{k}", Wrong())
+
+    with pytest.raises(UnitError) as err:
+        bg.compile(WrongBank(GROUP_FROM))
+    assert f"r0 .. r{GROUP_FROM - 1} ({GROUP_FROM} Wrong components): v == i" in str(err.value)
