@@ -24,6 +24,21 @@ from .passes.units import check_units
 from .structure.graph import gc_paused
 
 
+class Laps:
+    """``lap(stage)`` records into ``timings`` the seconds since the previous lap (or since
+    it was made) under ``stage``."""
+
+    __slots__ = ("timings", "last")
+
+    def __init__(self, timings: dict[str, float]) -> None:
+        self.timings, self.last = timings, _time.perf_counter()
+
+    def __call__(self, stage: str) -> None:
+        now = _time.perf_counter()
+        self.timings[stage] = now - self.last
+        self.last = now
+
+
 @dataclass
 class CompiledModel:
     """Everything the compiler produced, plus stage timings [s] in ``timings``."""
@@ -213,14 +228,7 @@ def _compile(model: Component, select: Selector | None, units: str = "error") ->
         raise DeclarationError(
             f"compile() expects a Component instance, got {type(model).__name__}")
     timings: dict[str, float] = {}
-    t = _time.perf_counter()
-
-    def lap(stage: str) -> None:
-        nonlocal t
-        now = _time.perf_counter()
-        timings[stage] = now - t
-        t = now
-
+    lap = Laps(timings)
     flat = flatten(model)
     n_flat = len(flat.equations)
     lap("flatten")
@@ -250,14 +258,7 @@ def recompile(compiled: CompiledModel, select: Selector) -> CompiledModel:
 def _reduce_and_build(flat: FlatModel, balance: BalanceReport, n_flat: int,
                       timings: dict[str, float], source: Any,
                       select: Selector | None) -> CompiledModel:
-    t = _time.perf_counter()
-
-    def lap(stage: str) -> None:
-        nonlocal t
-        now = _time.perf_counter()
-        timings[stage] = now - t
-        t = now
-
+    lap = Laps(timings)
     reduced = reduce_index(flat, select=select)
     if select is None:
         check_states(reduced)

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from ..compiler import CompiledModel
+from ..compiler import CompiledModel, Laps
 from ..errors import ModelError
 from ..structure.explicit_order import explicit_order
 from .build import assemble, solve_blocks
@@ -51,14 +51,7 @@ def _build(model: Any, units: str, minimum: int | None) -> ArrayCompiledModel | 
     from ..passes.units import check_equations
 
     timings: dict[str, float] = {}
-    t = _time.perf_counter()
-
-    def lap(stage: str) -> None:
-        nonlocal t
-        now = _time.perf_counter()
-        timings[stage] = now - t
-        t = now
-
+    lap = Laps(timings)
     col = collect(model, minimum)
     if isinstance(col, str):
         return col

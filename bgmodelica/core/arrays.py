@@ -24,50 +24,18 @@ connectors elementwise (a single connector is broadcast).
 from __future__ import annotations
 
 import re
-import weakref
 from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
 
 from ..errors import ConnectError, DeclarationError, EquationError
+from .array_marks import LEAVES, marked
 from .expr import ArrayBase, Equation, Expr, Leaf, Number, to_text
 
 #: math functions that stay whole-array operations (``sin(arr)``)
 LAZY_FUNCTIONS = frozenset({"sin", "cos", "tan", "exp", "log", "sqrt", "asin", "acos", "atan",
                             "sinh", "cosh", "tanh", "fabs", "sign"})
-
-
-#: arrays of declared scalars (a declared array, the derivatives of one), by the id of their
-#: numpy array of leaves, and those known to share one unit: block lowering and the unit
-#: check then need not read every element
-_LEAVES: weakref.WeakValueDictionary[int, np.ndarray] = weakref.WeakValueDictionary()
-_ONE_UNIT: weakref.WeakValueDictionary[int, np.ndarray] = weakref.WeakValueDictionary()
-
-
-def mark_leaves(items: np.ndarray, one_unit: bool) -> None:
-    """Record that ``items`` (a numpy array owning its data) holds leaves only, and whether
-    they share one unit."""
-    _LEAVES[id(items)] = items
-    if one_unit:
-        _ONE_UNIT[id(items)] = items
-
-
-def _marked(items: np.ndarray, registry: weakref.WeakValueDictionary) -> bool:
-    base = items.base if isinstance(items.base, np.ndarray) else items
-    return registry.get(id(base)) is base
-
-
-def is_declared(items: np.ndarray) -> bool:
-    """Whether ``items``, or the array it is a view of, holds the leaves of one declared
-    array or of their derivatives (:func:`mark_leaves`)."""
-    return _marked(items, _LEAVES)
-
-
-def has_one_unit(items: np.ndarray) -> bool:
-    """Whether ``items``, or the array it is a view of, holds leaves of one unit
-    (:func:`mark_leaves`)."""
-    return _marked(items, _ONE_UNIT)
 
 
 def element_names(name: str, shape: tuple[int, ...]) -> list[str]:
@@ -351,7 +319,7 @@ _SMOOTH_OPS = frozenset(_FUNCTIONS) | LAZY_FUNCTIONS | {"atan2", "fmin", "fmax"}
 def _block_operand(x: Any) -> bool:
     if isinstance(x, ArrayExpr):
         if x.node is None:                 # one type test per distinct element type
-            return _marked(x.items, _LEAVES) or \
+            return marked(x.items, LEAVES) or \
                 all(issubclass(t, Leaf) for t in set(map(type, x.items.flat)))
         return all(_block_operand(a) for a in x.node[1])
     if isinstance(x, (Number, float)):

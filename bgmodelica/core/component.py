@@ -31,6 +31,7 @@ import numpy as np
 
 from ..errors import ConnectError, DeclarationError, DuplicateNameError
 from ..structure.graph import gc_paused
+from .array_marks import mark_leaves
 from .arrays import (
     ArrayEquation,
     ArrayExpr,
@@ -39,7 +40,6 @@ from .arrays import (
     connect_arrays,
     element_names,
     element_values,
-    mark_leaves,
     normalize_shape,
 )
 from .expr import Expr, Leaf

@@ -56,7 +56,8 @@ def der(expr: Any) -> Any:
 def _leaf_rates(expr: ArrayBase) -> Any:
     """``der`` of a stored array of declared scalars (``der(v[:-1])``), element by element
     without the general differentiation; None for any other array."""
-    from .arrays import ArrayExpr, _wrap, has_one_unit, is_declared, mark_leaves
+    from .array_marks import has_one_unit, is_declared, mark_leaves
+    from .arrays import ArrayExpr, _wrap
 
     if not isinstance(expr, ArrayExpr) or expr.node is not None:
         return None

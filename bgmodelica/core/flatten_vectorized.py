@@ -26,7 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from .arrays import ArrayEquation, ArrayExpr, mark_leaves
+from .array_marks import mark_leaves
+from .arrays import ArrayEquation, ArrayExpr
 from .component import Component, Connector, _own_methods
 from .expr import Leaf
 

@@ -31,16 +31,16 @@ from __future__ import annotations
 import warnings
 from collections import Counter
 from collections.abc import Callable
-from fractions import Fraction
 from typing import Any
 
 import numpy as np
 
-from ..core.arrays import ArrayEquation, ArrayExpr, array_text, has_one_unit
+from ..core.array_marks import has_one_unit
+from ..core.arrays import ArrayEquation, ArrayExpr, array_text
 from ..core.expr import Equation, Expr, Leaf, Number, Op, to_text
 from ..core.flatmodel import EquationSources, FlatModel
 from ..core.hybrid import Reinit, SampleClock
-from ..core.units import ONE, SECOND, Unit, UnitParseError, name_of, parse
+from ..core.units import SECOND, UnitParseError, parse
 from ..core.variables import (
     Boolean,
     Discrete,
@@ -53,6 +53,20 @@ from ..core.variables import (
     Variable,
 )
 from ..errors import UnitError
+from .unit_values import (
+    DIMLESS,
+    FREE,
+    LIT,
+    Adaptive,
+    Known,
+    Mismatch,
+    combine,
+    der_text,
+    dimensionless,
+    div,
+    mul,
+    power,
+)
 
 MODES = ("error", "warn", "off")
 
@@ -97,142 +111,6 @@ def check_sources(sources: EquationSources, mode: str) -> list[str]:
     return problems
 
 
-# -- unit values ------------------------------------------------------------------------------
-
-
-class _Adaptive:
-    """A value whose unit adapts to what it meets: a literal, or an undeclared unit."""
-
-    __slots__ = ("name",)
-
-    def __init__(self, name: str) -> None:
-        self.name = name
-
-    def __repr__(self) -> str:
-        return self.name
-
-
-LIT = _Adaptive("a number")          # a pure number: 1 in products, adapts in sums
-FREE = _Adaptive("no unit")          # declared without unit: adapts everywhere, also in products
-
-
-class _U:
-    """A concrete unit: how it reads from the declarations (``"Ohm.A"``) and its value."""
-
-    __slots__ = ("text", "unit")
-
-    def __init__(self, text: str, unit: Unit) -> None:
-        self.text = text
-        self.unit = unit
-
-    def __str__(self) -> str:
-        name = name_of(self.unit)
-        return self.text if name == self.text else f"{self.text} ({name})"
-
-
-DIMLESS = _U("1", ONE)
-
-
-class _Mismatch(Exception):
-    pass
-
-
-def _outside_parentheses(text: str, chars: str) -> bool:
-    depth = 0
-    for c in text:
-        depth += (c == "(") - (c == ")")
-        if depth == 0 and c in chars:
-            return True
-    return False
-
-
-def _wrap(text: str) -> str:
-    return f"({text})" if _outside_parentheses(text, "/") else text
-
-
-def _simple(text: str) -> bool:
-    return not _outside_parentheses(text, "./")
-
-
-def _mul_text(a: str, b: str) -> str:
-    if a == "1":
-        return b
-    if b == "1":
-        return a
-    return f"{_wrap(a)}.{_wrap(b)}"
-
-
-def _div_text(a: str, b: str) -> str:
-    if b == "1":
-        return a
-    return f"{_wrap(a)}/{b if _simple(b) else f'({b})'}"
-
-
-def _pow_text(a: str, p: Fraction) -> str:
-    if p == 1:
-        return a
-    if a == "1":
-        return a
-    if _simple(a) and p.denominator == 1:
-        return f"{a}{p}"
-    return f"({a})^{p if p.denominator == 1 else f'({p})'}"
-
-
-def _der_text(a: str, n: int) -> str:
-    if a == "1":
-        return "1/s" if n == 1 else f"1/s{n}"
-    head, sep, tail = a.rpartition("/s")
-    if sep and (tail == "" or tail.isdigit()) and "(" not in head and "/" not in head:
-        return f"{head}/s{int(tail or 1) + n}"
-    return _div_text(a, "s" if n == 1 else f"s{n}")
-
-
-def _combine(a: Any, b: Any, message: str) -> Any:
-    """The common unit of ``a`` and ``b`` (which must agree)."""
-    if isinstance(a, _Adaptive):
-        return a if b is LIT else b
-    if isinstance(b, _Adaptive):
-        return a
-    if a.unit.same(b.unit):
-        return a
-    raise _Mismatch(message.format(a, b))
-
-
-def _dimensionless(a: Any, what: str) -> None:
-    if isinstance(a, _U) and not (a.unit.dimensionless
-                                  and abs(a.unit.factor - 1.0) <= 1e-12):
-        raise _Mismatch(f"{what} needs a dimensionless argument, got {a}")
-
-
-def _mul(a: Any, b: Any) -> Any:
-    if a is FREE or b is FREE:
-        return FREE
-    if a is LIT:
-        return b
-    if b is LIT:
-        return a
-    return _U(_mul_text(a.text, b.text), a.unit * b.unit)
-
-
-def _div(a: Any, b: Any) -> Any:
-    if a is FREE or b is FREE:
-        return FREE
-    if b is LIT:
-        return a
-    if a is LIT:
-        a = DIMLESS
-    return _U(_div_text(a.text, b.text), a.unit / b.unit)
-
-
-def _pow(a: Any, p: float) -> Any:
-    if isinstance(a, _Adaptive):
-        return a
-    q = Fraction(p).limit_denominator(1000)
-    if a.unit.dimensionless and a.unit.factor == 1.0:
-        return a
-    return _U(_pow_text(a.text, q), a.unit ** p)
-
-
 _TRANSCENDENTAL = frozenset(("sin", "cos", "tan", "exp", "log", "asin", "acos", "atan", "sinh",
                              "cosh", "tanh"))
 _SAME = frozenset(("neg", "fabs", "noEvent", "floor", "ceil"))
@@ -262,7 +140,7 @@ class _Checker:
         for name, decl, where in src.bindings:
             self._guard(lambda n=name, d=decl, w=where: f"{w}: parameter {n} = "
                                                         f"{to_text(d.value)}",
-                        lambda d=decl: _combine(self.value(d.unit, None), self.infer(d.value),
+                        lambda d=decl: combine(self.value(d.unit, None), self.infer(d.value),
                                                 "declared in {0}, bound to a value in {1}"))
         for eq, where in src.initial:
             self._guard(lambda e=eq, w=where: f"{w}: initial equation {to_text(e.lhs)} == "
@@ -272,7 +150,7 @@ class _Checker:
             if isinstance(a, Leaf) and isinstance(b, Leaf):
                 self._guard(lambda a=a, b=b, w=where: f"{w}: connect({to_text(a)}, "
                                                        f"{to_text(b)})",
-                            lambda a=a, b=b: _combine(self.infer(a), self.infer(b),
+                            lambda a=a, b=b: combine(self.infer(a), self.infer(b),
                                                       "{0} connected to {1}"))
         return self.problems
 
@@ -280,7 +158,7 @@ class _Checker:
         """Run ``fn``; report a mismatch with the text ``context()`` (built only then)."""
         try:
             fn()
-        except _Mismatch as m:
+        except Mismatch as m:
             more = (f" (and {count - 1} more equation{'s' if count > 2 else ''} of the same "
                     "form and units)") if count > 1 else ""
             self.report(f"{context()}: {m}{more}")
@@ -316,13 +194,13 @@ class _Checker:
 
     def equation(self, eq: Equation) -> Any:
         lhs, rhs = self.infer(eq.lhs), self.infer(eq.rhs)
-        return _combine(lhs, rhs, "left side is {0}, right side is {1}")
+        return combine(lhs, rhs, "left side is {0}, right side is {1}")
 
     # -- hybrid parts
     def _hybrid(self, draft: Any) -> None:
         for slot in draft.relations:
             self._guard(lambda s=slot: f"{s.where}: {to_text(s.a)} {s.op} {to_text(s.b)}",
-                        lambda s=slot: _combine(self.infer(s.a), self.infer(s.b),
+                        lambda s=slot: combine(self.infer(s.a), self.infer(s.b),
                                                 "cannot compare {0} and {1}"))
         for w, here in draft.whens:
             for cond, stmts in w.branches:
@@ -333,21 +211,21 @@ class _Checker:
                         self._guard(
                             lambda h=here, s=s: f"{h}: reinit({s.target.name}, "
                                                 f"{to_text(s.value)})",
-                            lambda s=s: _combine(self.infer(s.target.leaf), self.infer(s.value),
+                            lambda s=s: combine(self.infer(s.target.leaf), self.infer(s.value),
                                                  f"{s.target.name} is in {{0}}, the new value "
                                                  "in {1}"))
                     else:
                         self._guard(lambda h=here, c=cond, s=s: f"{h}: when {to_text(c)}: "
                                     f"{to_text(s.lhs)} == {to_text(s.rhs)}",
                                     lambda s=s: self.equation(s))
-        second = _U("s", SECOND)
+        second = Known("s", SECOND)
         for sym in draft.specials.values():
             if isinstance(sym, SampleClock):
                 self._guard(lambda s=sym: f"sample({to_text(s.start)}, {to_text(s.interval)})",
                             lambda s=sym: (
-                                _combine(second, self.infer(s.start),
+                                combine(second, self.infer(s.start),
                                          "start must be in {0}, got {1}"),
-                                _combine(second, self.infer(s.interval),
+                                combine(second, self.infer(s.interval),
                                          "interval must be in {0}, got {1}")))
 
     # -- units of expressions
@@ -360,14 +238,14 @@ class _Checker:
             out = FREE
         elif isinstance(key, tuple):              # ("der", n, key of the differentiated)
             base = self.value(key[2], sym)
-            out = base if isinstance(base, _Adaptive) else _U(
-                _der_text(base.text, key[1]), base.unit / SECOND ** key[1])
+            out = base if isinstance(base, Adaptive) else Known(
+                der_text(base.text, key[1]), base.unit / SECOND ** key[1])
         else:
             try:
-                out = _U(key, parse(key))
+                out = Known(key, parse(key))
             except UnitParseError as err:
                 name = getattr(sym, "name", "?")
-                raise _Mismatch(f"{name} is declared in an unknown unit: {err}") from None
+                raise Mismatch(f"{name} is declared in an unknown unit: {err}") from None
         self.values[key] = out
         return out
 
@@ -382,49 +260,49 @@ class _Checker:
         if op in ("+", "-"):
             a, b = self.infer(args[0]), self.infer(args[1])
             verb = "add" if op == "+" else "subtract"
-            return _combine(a, b, f"cannot {verb} {{0}} and {{1}}")
+            return combine(a, b, f"cannot {verb} {{0}} and {{1}}")
         if op == "*":
-            return _mul(self.infer(args[0]), self.infer(args[1]))
+            return mul(self.infer(args[0]), self.infer(args[1]))
         if op == "/":
-            return _div(self.infer(args[0]), self.infer(args[1]))
+            return div(self.infer(args[0]), self.infer(args[1]))
         if op in _SAME:
             return self.infer(args[0])
         if op in _TRANSCENDENTAL:
             a = self.infer(args[0])
-            _dimensionless(a, f"{op}()")
+            dimensionless(a, f"{op}()")
             return LIT if a is LIT else DIMLESS
         if op == "sqrt":
-            return _pow(self.infer(args[0]), 0.5)
+            return power(self.infer(args[0]), 0.5)
         if op == "**":
             base = self.infer(args[0])
             if isinstance(args[1], float):
-                return _pow(base, args[1])
+                return power(base, args[1])
             p = self.infer(args[1])
-            _dimensionless(p, "an exponent")
-            if isinstance(base, _Adaptive):
+            dimensionless(p, "an exponent")
+            if isinstance(base, Adaptive):
                 return base
-            _dimensionless(base, "a power with a variable exponent")
+            dimensionless(base, "a power with a variable exponent")
             return DIMLESS
         if op in _COMPARE:
-            _combine(self.infer(args[0]), self.infer(args[1]), "cannot compare {0} and {1}")
+            combine(self.infer(args[0]), self.infer(args[1]), "cannot compare {0} and {1}")
             return DIMLESS
         if op in _LOGIC:
             for a in args:
-                _dimensionless(self.infer(a), f"'{op}'")
+                dimensionless(self.infer(a), f"'{op}'")
             return DIMLESS
         if op == "sign":
             self.infer(args[0])
             return DIMLESS
         if op == "atan2":
-            _combine(self.infer(args[0]), self.infer(args[1]),
+            combine(self.infer(args[0]), self.infer(args[1]),
                      "atan2() needs arguments in one unit, got {0} and {1}")
             return DIMLESS
         if op in ("fmin", "fmax"):
-            return _combine(self.infer(args[0]), self.infer(args[1]),
+            return combine(self.infer(args[0]), self.infer(args[1]),
                             f"{op}() needs arguments in one unit, got {{0}} and {{1}}")
         if op == "if_else":
-            _dimensionless(self.infer(args[0]), "an if_else condition")
-            return _combine(self.infer(args[1]), self.infer(args[2]),
+            dimensionless(self.infer(args[0]), "an if_else condition")
+            return combine(self.infer(args[1]), self.infer(args[2]),
                             "if_else branches differ: {0} and {1}")
         return FREE                           # an operation this check does not know
 
