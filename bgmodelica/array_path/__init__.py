@@ -2,7 +2,8 @@
 per scalar.
 
 ``compile`` sends a model here first (:func:`compile_arrays`). A model it takes (see
-:mod:`.collect`) is lowered to MX blocks (:mod:`.lowering`), ordered on its integer incidence
+:mod:`.collect`) is lowered to MX blocks (:mod:`.lowering`), its aliases eliminated
+(:mod:`.aliases`), ordered on its integer incidence
 (:mod:`bgmodelica.structure.explicit_order`), solved block by block and assembled into the
 same :class:`~bgmodelica.backends.casadi_dae.CasadiDAE` the scalar pipeline builds: the same
 variable names and order, states, parameters, start values and ODE. A model it does not take,
@@ -25,6 +26,7 @@ import numpy as np
 from ..compiler import CompiledModel, Laps
 from ..errors import ModelError
 from ..structure.explicit_order import explicit_order
+from .aliases import find_aliases
 from .build import assemble, solve_blocks
 from .collect import ARRAY_PATH_FROM, collect
 from .lowering import Lowered
@@ -64,19 +66,32 @@ def _build(model: Any, units: str, minimum: int | None) -> ArrayCompiledModel | 
         return f"{type(err).__name__}: {err}"
     if isinstance(found, str):
         return found
+    variables = col.order
+    if found.aliases:
+        variables = [v for v in col.order if v.name not in found.aliases]
     return ArrayCompiledModel.made(col.name, found, col.n_rows, timings, model, units,
-                                   col.order)
+                                   variables)
 
 
 def _compile_blocks(col: Any, lap: Any) -> Any:
     """The :class:`~bgmodelica.backends.casadi_dae.CasadiDAE` of a collected model, or why
     its equations do not solve explicitly block by block."""
     low = Lowered(col)
+    aliases = find_aliases(col)
+    if isinstance(aliases, str):
+        return aliases
+    n = len(col.order)
+    kept = np.ones(n, dtype=bool)
+    if aliases is not None:
+        low.eliminate(aliases.dropped, aliases.target, aliases.sign)
+        kept[:] = False
+        kept[aliases.keep] = True
     lap("lowering")
-    is_state = np.fromiter((s.der is not None for s in col.order), bool, len(col.order))
-    unknown = np.flatnonzero(~is_state)
-    if unknown.size != col.n_rows:
-        return f"{col.n_rows} equations for {unknown.size} unknowns"
+    is_state = np.fromiter((s.der is not None for s in col.order), bool, n)
+    unknown = np.flatnonzero(~is_state & kept)
+    n_rows = int(sum(low.sizes))
+    if unknown.size != n_rows:
+        return f"{n_rows} equations for {unknown.size} unknowns"
     as_unknown = np.full(low.n + low.n_p + 1, -1, dtype=np.int64)
     as_unknown[unknown] = np.arange(unknown.size)
     cols = as_unknown[low.cols]
@@ -89,7 +104,7 @@ def _compile_blocks(col: Any, lap: Any) -> Any:
     if isinstance(solved, str):
         return solved
     lap("solve")
-    dae = assemble(col, low, solved, np.flatnonzero(is_state))
+    dae = assemble(col, low, solved, np.flatnonzero(is_state), aliases)
     lap("backend")
     return dae
 
@@ -162,4 +177,4 @@ class Declarations:
         self.parameters = compiled.dae.parameters
         self.inputs: list[Any] = []
         self.discretes: list[Any] = []
-        self.aliases: dict[str, tuple[str, float]] = {}
+        self.aliases: dict[str, tuple[str, float]] = compiled.dae.aliases

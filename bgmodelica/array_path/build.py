@@ -21,6 +21,7 @@ from ..backends.casadi_dae import CSE_UP_TO, CasadiDAE
 from ..core.flatmodel import FlatVariable
 from ..core.variables import TIME
 from ..structure.explicit_order import ExplicitOrder
+from .aliases import Aliases
 from .collect import Collected
 from .lowering import Lowered
 
@@ -57,13 +58,15 @@ def _column(n: int, rows: np.ndarray) -> ca.Sparsity:
     return ca.Sparsity(n, 1, [0, int(rows.size)], rows.tolist())
 
 
-def assemble(col: Collected, low: Lowered, solved: ca.MX, states: np.ndarray) -> CasadiDAE:
+def assemble(col: Collected, low: Lowered, solved: ca.MX, states: np.ndarray,
+             aliases: Aliases | None = None) -> CasadiDAE:
     """The :class:`CasadiDAE` of the model: the same names, orders, states and parameters
     as the scalar pipeline's. Its SX symbols are one column ``v``: the states, then the
-    parameters (the other variables are observations)."""
+    parameters (the other variables are observations). ``aliases``: the eliminated ones."""
     n, n_p = low.n, low.n_p
     n_x = states.size
     order = col.order
+    kept = aliases.keep.tolist() if aliases is not None else list(range(n))
     column = ca.SX.sym("v", n_x + n_p)
     x, p = column[:n_x], column[n_x:]
     state_list = states.tolist()
@@ -71,25 +74,38 @@ def assemble(col: Collected, low: Lowered, solved: ca.MX, states: np.ndarray) ->
     # solve_blocks), and every other was replaced by its solution
     x_in = ca.SX(ca.Sparsity(n, 1, [0, n_x], state_list), x)
     derivatives = [j + 1 for j in state_list]                   # der(x) follows x
-    f = ca.Function("array_path", [low.x, low.p, low.t], [solved[derivatives], solved])
+    f = ca.Function("array_path", [low.x, low.p, low.t],
+                    [solved[derivatives], solved[kept] if aliases is not None else solved])
     ode, observed = f(x_in, p, TIME.sx)
-    if n_x + n <= CSE_UP_TO:
+    if n_x + len(kept) <= CSE_UP_TO:
         both = ca.cse(ca.vertcat(ode, observed))
         ode, observed = both[:n_x], both[n_x:]
-    names = list(map(_NAME, order))
-    decls = list(map(_DECL, order))
-    fixed = [(k, float(decls[k].start))
-             for k in compress(range(n), map(attrgetter("fixed"), decls))]
+    kept_vars = order if aliases is None else [order[j] for j in kept]
+    names = list(map(_NAME, kept_vars))
+    decls = list(map(_DECL, kept_vars))
+    merged = aliases.starts if aliases is not None else {}
+    if merged:                                   # representatives given an alias's start
+        at = {j: k for k, j in enumerate(kept)}
+        starts = [float(d.start) for d in decls]
+        flags = [bool(d.fixed) for d in decls]
+        for j, (start, fixed) in merged.items():
+            starts[at[j]], flags[at[j]] = start, fixed
+    else:
+        starts, flags = list(map(attrgetter("start"), decls)), \
+            list(map(attrgetter("fixed"), decls))
+    fixed = [(k, float(starts[k])) for k in compress(range(len(kept)), flags)]
+    position = dict(zip(kept, range(len(kept)), strict=True)) if aliases is not None else None
+    state_pos = state_list if position is None else [position[j] for j in state_list]
     parameters = list(map(FlatVariable, map(_NAME, col.params), repeat(None),
                           map(_DECL, col.params), repeat(""), repeat(-1), repeat(-1),
                           zip(repeat(column), range(n_x, n_x + n_p))))
     return CasadiDAE(
         x=x, z=ca.SX(0, 1), p=p if n_p else ca.SX(0, 1),
         t=TIME.sx, ode=ode, alg=ca.SX(0, 1), observed=observed,
-        names=names, state_names=[names[j] for j in state_list], algebraic_names=[],
+        names=names, state_names=[names[k] for k in state_pos], algebraic_names=[],
         parameters=parameters, inputs=[],
-        x_start=np.fromiter(map(attrgetter("start"), map(decls.__getitem__, state_list)),
-                            float, n_x),
+        x_start=np.fromiter(map(float, map(starts.__getitem__, state_pos)), float, n_x),
         z_start=np.zeros(0), fixed=fixed,
-        observed_index=dict(zip(names, range(n), strict=True)), n_variables=n,
-        differentiated={names[j] for j in state_list})
+        observed_index=dict(zip(names, range(len(names)), strict=True)),
+        n_variables=len(names), differentiated={names[k] for k in state_pos},
+        aliases=dict(aliases.names) if aliases is not None else {})

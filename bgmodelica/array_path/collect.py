@@ -9,7 +9,8 @@ is the one the scalar pipeline gives; anything else goes the usual way:
   :class:`~bgmodelica.core.variables.Parameter` declarations, parameters given as numbers;
 - equations that are array equations lowered as blocks, or a few scalar equations, built
   from whole-array arithmetic and the smooth math functions (no relations, events or
-  ``if_else``), none of them an alias ``a == b`` between two variables;
+  ``if_else``); aliases ``a == b`` between variables are eliminated as the scalar pipeline
+  eliminates them (:mod:`.aliases`);
 - at least :data:`ARRAY_PATH_FROM` scalar equations (below, the scalar pipeline is as fast).
 """
 
@@ -97,8 +98,6 @@ def collect(model: Any, minimum: int | None = None) -> Collected | str:
     n_rows = n_scalar = 0
     for eq in equations:
         if isinstance(eq, ArrayEquation):
-            if _is_alias_array(eq):
-                return "an array equation is an alias"
             n_rows += len(eq)
         elif type(eq) is Equation:
             n_scalar += 1
@@ -106,8 +105,6 @@ def collect(model: Any, minimum: int | None = None) -> Collected | str:
                 return "many scalar equations"
             if not (_block_operand(eq.lhs) and _block_operand(eq.rhs)):
                 return "a scalar equation is not smooth arithmetic"
-            if _is_alias_scalar(eq):
-                return "a scalar equation is an alias"
             n_rows += 1
         else:
             return f"it has a {type(eq).__name__}"
@@ -142,6 +139,64 @@ def collect(model: Any, minimum: int | None = None) -> Collected | str:
     pos.update(zip(map(id, ders), (var_col[has_der] + 1).tolist(), strict=True))
     pos[id(TIME)] = n + len(params)
     return Collected(name, where, order, params, equations, n_rows, pos, memo)
+
+
+def _first_element(key: str, shape: tuple[int, ...]) -> str:
+    return f"{key}[{','.join(['1'] * len(shape))}]"
+
+
+def _runs(model: Any, names: list[str]) -> list[tuple[int, int, bool]]:
+    """``(start, size, is_array)`` of each declaration in ``names`` (the model's symbols in
+    order): a declared array is one run of its elements, a scalar a run of one."""
+    arrays = sorted((names.index(_first_element(key, shape)), int(np.prod(shape)))
+                    for key, shape in model.__dict__.get("_arrays", {}).items())
+    out: list[tuple[int, int, bool]] = []
+    k = 0
+    for start, size in arrays:
+        out.extend((j, 1, False) for j in range(k, start))
+        out.append((start, size, True))
+        k = start + size
+    out.extend((j, 1, False) for j in range(k, len(names)))
+    return out
+
+
+_ELEMENT = re.compile(r"^(.*)\[([0-9,]+)\]$")
+
+
+class _Positions(dict):
+    """``id(symbol)`` -> column; the elements of declared arrays are added on the first
+    lookup that misses (most equations read them through ``memo``, by slices, and
+    :meth:`of` finds one element by its name)."""
+
+    def __init__(self, symbols: list[Any], column: np.ndarray) -> None:
+        super().__init__()
+        self.symbols, self.column = symbols, column
+        self.all = symbols
+        self.arrays: dict[str, tuple[int, tuple[int, ...]]] = {}
+
+    def of(self, sym: Any) -> int:
+        """The column of ``sym`` (KeyError for a symbol of another component)."""
+        found = self.get(id(sym))
+        if found is not None:
+            return found
+        m = _ELEMENT.match(getattr(sym, "name", ""))
+        run = self.arrays.get(m.group(1)) if m else None
+        if run is not None:
+            start, shape = run
+            index = tuple(int(i) - 1 for i in m.group(2).split(","))
+            if len(index) == len(shape) and all(0 <= i < d for i, d in zip(index, shape,
+                                                                           strict=True)):
+                k = start + int(np.ravel_multi_index(index, shape))
+                if self.all[k] is sym:
+                    return int(self.column[k])
+        return self[id(sym)]
+
+    def __missing__(self, key: int) -> int:
+        if self.symbols is None:
+            raise KeyError(key)
+        self.update(zip(map(id, self.symbols), self.column.tolist(), strict=True))
+        self.symbols = None
+        return self[key]
 
 
 def _first_element(key: str, shape: tuple[int, ...]) -> str:

@@ -56,6 +56,26 @@ class Lowered:
         self.rows = np.concatenate(rows) if rows else np.zeros(0, dtype=np.int64)
         self.cols = np.concatenate(cols) if cols else np.zeros(0, dtype=np.int64)
 
+    def eliminate(self, dropped: set[int], target: np.ndarray, sign: np.ndarray) -> None:
+        """Drop the blocks ``dropped`` (alias equations) and read every column ``k`` of
+        ``x`` as ``sign[k] * x[target[k]]`` in the others (the eliminated aliases)."""
+        starts = np.concatenate([[0], np.cumsum(self.sizes)]).astype(np.int64)
+        kept = [k for k in range(len(self.blocks)) if k not in dropped]
+        row_kept = np.zeros(int(starts[-1]), dtype=bool)
+        for k in kept:
+            row_kept[starts[k]:starts[k + 1]] = True
+        renumber = np.cumsum(row_kept) - 1
+        used = row_kept[self.rows]
+        cols = self.cols[used]
+        inside = cols < self.n
+        cols[inside] = target[cols[inside]]
+        self.rows, self.cols = renumber[self.rows[used]], cols
+        read = self.x[target.tolist()]
+        if (sign != 1.0).any():
+            read = read * ca.DM(sign)
+        self.blocks = [ca.substitute(self.blocks[k], self.x, read) for k in kept]
+        self.sizes = [self.sizes[k] for k in kept]
+
     def lower(self, x: Any, want: tuple[int, ...]) -> tuple[Any, list[np.ndarray]]:
         """``x`` as an MX column of shape ``want`` (C order) and, per operand array, the
         column index of each of its elements (broadcast the same way)."""

@@ -337,3 +337,62 @@ def test_the_array_path_can_be_turned_off():
     compiled = bg.compile(RCLadderVector(1000), array_path=False)
     assert not isinstance(compiled, ArrayCompiledModel) and "flatten" in compiled.timings
     _same_dae(bg.compile(RCLadderVector(1000)).dae, compiled.dae)
+
+
+class Aliased(Component):
+    """:class:`Decays`-like with aliases: ``w = x`` (an array alias, ``w`` fixed at the
+    start), ``m = -x[1]`` (a scalar one) and ``q[1:n] = y[1:n]`` beside ``y = 2*x``."""
+
+    x = Variable(shape="n")
+    w = Variable(shape="n")
+    y = Variable(shape="n")
+    q = Variable(shape="n")
+    m = Variable()
+    k = Parameter(shape="n", value=1.0)
+
+    def __init__(self, n: int = 4, **modifiers):
+        self.n = n
+        super().__init__(**{"k": np.linspace(0.5, 2.0, n),
+                            "w": np.linspace(1.0, 3.0, n), **modifiers})
+
+    def equations(self):
+        yield der(self.x) == -self.k * self.x
+        yield self.w == self.x
+        yield self.m == -self.x[0]
+        yield self.y == 2.0 * self.x
+        yield self.q == self.y
+
+
+@pytest.mark.parametrize("n", [2, 7])
+def test_aliases_are_eliminated_as_the_scalar_pipeline_does(n):
+    fast = compile_arrays(Aliased(n), minimum=0)
+    assert isinstance(fast, ArrayCompiledModel)
+    slow = _compile(Aliased(n), None)
+    assert fast.dae.aliases == slow.dae.aliases and fast.dae.aliases
+    _same_dae(fast.dae, slow.dae)
+    res = bg.simulate(fast, stop_time=1.0, interval=0.5, **TIGHT)
+    k, x0 = np.linspace(0.5, 2.0, n), np.linspace(1.0, 3.0, n)
+    assert res["w[2]"][-1] == pytest.approx(x0[1] * np.exp(-k[1]), rel=1e-8)
+    assert res["m"][-1] == pytest.approx(-x0[0] * np.exp(-k[0]), rel=1e-8)
+    assert res["q[1]"][-1] == pytest.approx(2 * x0[0] * np.exp(-k[0]), rel=1e-8)
+
+
+class LoopedAliases(Component):
+    """``a = b``, ``b = c``, ``c = a``: a cycle of alias links (one is an ordinary
+    equation then), with ``der(a) = -a``."""
+
+    a = Variable(shape=3, start=1.0, fixed=True)
+    b = Variable(shape=3)
+    c = Variable(shape=3)
+
+    def equations(self):
+        yield der(self.a) == -self.a
+        yield self.a == self.b
+        yield self.b == self.c
+        yield self.c == self.a
+
+
+def test_alias_cycles_and_conflicts_go_the_scalar_way():
+    assert "cycle" in why_not(LoopedAliases(), minimum=0)
+    conflicting = Aliased(3, x={"start": 5.0, "fixed": True})
+    assert "conflicting" in why_not(conflicting, minimum=0)
