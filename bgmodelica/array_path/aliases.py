@@ -17,7 +17,7 @@ import numpy as np
 from ..core.arrays import ArrayEquation
 from ..core.expr import alias_signs
 from ..core.flatten import _side_shape
-from ..core.flatten_arrays import alias_pairs
+from ..core.flatten_arrays import _rows, _signature
 from ..structure.alias import alias_classes
 from .collect import Collected
 
@@ -42,60 +42,55 @@ def find_aliases(col: Collected) -> Aliases | str | None:
     """The alias elimination of a collected model; None without aliases, a reason string
     when it must be left to the scalar pipeline."""
     order, pos = col.order, col.pos
-    links: list[tuple[int, int, float]] = []
-    link_eq: list[int] = []            # the equation of each link
-    rows_of: dict[int, list[Any]] = {}   # equation -> its links (None for an ordinary row)
+    n = len(order)
+    plain = np.zeros(n + len(col.params) + 1, dtype=bool)   # variables that may be linked
+    plain[:n] = np.fromiter((s.der_of is None for s in order), bool, n)
+    heads: list[np.ndarray] = []
+    tails: list[np.ndarray] = []
+    factors: list[np.ndarray] = []
+    linked_rows: dict[int, np.ndarray] = {}   # equation -> which of its rows are links
 
-    def column(sym: Any) -> int | None:
-        if getattr(sym, "der_of", True) is not None or getattr(sym, "decl", None) is None \
-                or sym.decl.kind != "variable":
-            return None
-        try:
-            return pos.of(sym)
-        except KeyError:
-            return None
-
-    def link(k: int, sa: float, a: Any, sb: float, b: Any) -> Any:
-        ia, ib = column(a), column(b)
-        if ia is None or ib is None or ia == ib:
-            return None
-        links.append((ia, ib, -sb / sa))
-        link_eq.append(k)
-        return links[-1]
+    def add(k: int, a: np.ndarray, b: np.ndarray, factor: float) -> None:
+        ok = plain[a] & plain[b] & (a != b)
+        linked_rows[k] = ok
+        heads.append(a[ok])
+        tails.append(b[ok])
+        factors.append(np.full(int(ok.sum()), factor))
 
     # the scalar pipeline's order: scalar equations grouped by shape (first seen first),
     # then the array equations
-    groups: dict[Any, list[tuple[int, Any, list, list]]] = {}
+    groups: dict[Any, list[tuple[int, list, list]]] = {}
     for k, eq in enumerate(col.equations):
         if not isinstance(eq, ArrayEquation):
             leaves: list = []
             consts: list = []
             key = (_side_shape(eq.lhs, leaves, consts), _side_shape(eq.rhs, leaves, consts))
-            groups.setdefault(key, []).append((k, eq, leaves, consts))
+            groups.setdefault(key, []).append((k, leaves, consts))
     for key, members in groups.items():
         signs = alias_signs(*key)
-        for k, _, leaves, consts in members:
-            found = None if not signs or any(consts) else \
-                link(k, signs[0], leaves[0], signs[1], leaves[1])
-            rows_of[k] = [found]
+        if not signs:
+            continue
+        for k, leaves, consts in members:
+            if not any(consts):
+                a, b = (np.array([_column(pos, s, n)]) for s in leaves[:2])
+                add(k, a, b, -signs[1] / signs[0])
     for k, eq in enumerate(col.equations):
         if isinstance(eq, ArrayEquation):
-            pairs = alias_pairs(eq)
-            if pairs is None:
-                continue
-            sa, sb, a, b = pairs
-            rows_of[k] = [link(k, sa, la.sym, sb, lb.sym) for la, lb in zip(a, b, strict=True)]
-    if not links:
+            found = _array_link(eq, col)
+            if found is not None:
+                add(k, *found)
+    links_a = np.concatenate(heads) if heads else np.zeros(0, dtype=np.int64)
+    if not links_a.size:
         return None
+    links_b, signs_ = np.concatenate(tails), np.concatenate(factors)
     dropped = set()
-    for k, rows in rows_of.items():
-        found = [r is not None for r in rows]
-        if all(found):
+    for k, ok in linked_rows.items():
+        if ok.all():
             dropped.add(k)
-        elif any(found):
+        elif ok.any():
             return "an array equation is partly of aliases"
-    n = len(order)
-    classes = alias_classes(n, links, _ranks(order, links))
+    links = list(zip(links_a.tolist(), links_b.tolist(), signs_.tolist(), strict=True))
+    classes = alias_classes(n, links, _ranks(order, links_a, links_b))
     if classes.redundant:
         return "alias equations close a cycle"
     rep = np.asarray(classes.rep, dtype=np.int64)
@@ -112,19 +107,45 @@ def find_aliases(col: Collected) -> Aliases | str | None:
                    names, starts)
 
 
-def _ranks(order: list[Any], links: list[tuple[int, int, float]]) -> list[int]:
-    """:func:`bgmodelica.passes.alias._ranks` on the collected columns."""
-    linked = {i for a, b, _ in links for i in (a, b)}
-    keys = {}
-    for i in linked:
-        v = order[i]
-        keys[i] = (v.der is not None, int(getattr(v.decl, "state_select", 0)),
-                   bool(getattr(v.decl, "fixed", False)), -v.name.count("."), -len(v.name))
-    dense = {key: k for k, key in enumerate(sorted(set(keys.values())))}
-    out = [0] * len(order)
-    for i, key in keys.items():
-        out[i] = dense[key]
-    return out
+def _column(pos: Any, sym: Any, n: int) -> int:
+    """The column of a scalar leaf (``n``, past the variables, for a parameter or time)."""
+    try:
+        k = pos.of(sym)
+    except KeyError:
+        return n
+    return k if k < n else n
+
+
+def _array_link(eq: ArrayEquation, col: Collected) -> tuple[np.ndarray, np.ndarray, float] | None:
+    """The columns of ``sa*a + sb*b = 0`` between two arrays of leaves, element by element
+    (broadcast to the equation's shape), and the factor ``-sb/sa``; None for any other
+    form (:func:`~bgmodelica.core.flatten_arrays.alias_pairs`)."""
+    leaves: list = []
+    consts: list = []
+    signs = alias_signs(_signature(eq.lhs, leaves, consts), _signature(eq.rhs, leaves, consts))
+    if not signs or any(np.any(np.asarray(c) != 0.0) for c in consts):
+        return None
+    shape = eq.shape
+    a, b = (np.broadcast_to(np.asarray(_rows(arr.items, col.pos, col.memo), dtype=np.int64)
+                            .reshape(arr.shape), shape).ravel() for arr in leaves)
+    return a, b, -signs[1] / signs[0]
+
+
+def _ranks(order: list[Any], heads: np.ndarray, tails: np.ndarray) -> list[int]:
+    """:func:`bgmodelica.passes.alias._ranks` on the collected columns: the dense rank of
+    (has a derivative, state priority, fixed start, fewer dots, shorter name) among the
+    linked variables, 0 for the others."""
+    linked = np.unique(np.concatenate([heads, tails]))
+    syms = [order[i] for i in linked.tolist()]
+    keys = list(zip((s.der is not None for s in syms),
+                    (int(getattr(s.decl, "state_select", 0)) for s in syms),
+                    (bool(getattr(s.decl, "fixed", False)) for s in syms),
+                    (-s.name.count(".") for s in syms), (-len(s.name) for s in syms),
+                    strict=True))
+    dense = {key: k for k, key in enumerate(sorted(set(keys)))}
+    out = np.zeros(len(order), dtype=np.int64)
+    out[linked] = [dense[key] for key in keys]
+    return out.tolist()
 
 
 def _merged_starts(order: list[Any], rep: list[int], sign: list[float],
