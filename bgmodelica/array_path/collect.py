@@ -5,7 +5,8 @@ equations without making a Python object per scalar. It takes a model only when 
 is the one the scalar pipeline gives; anything else goes the usual way:
 
 - one component, without subcomponents, connectors, connections or initial equations;
-- plain :class:`~bgmodelica.core.variables.Variable` (default state selection) and
+- plain :class:`~bgmodelica.core.variables.Variable` and
+  :class:`~bgmodelica.core.variables.Output` (default state selection) and
   :class:`~bgmodelica.core.variables.Parameter` declarations, parameters given as numbers;
 - equations that are array equations lowered as blocks, or a few scalar equations, built
   from whole-array arithmetic and the smooth math functions (no relations, events or
@@ -26,9 +27,8 @@ import numpy as np
 
 from ..core.arrays import ArrayEquation, _block_operand
 from ..core.component import Component, _own_methods
-from ..core.expr import Equation, Leaf, Op, alias_signs, shape_of
-from ..core.flatten_arrays import alias_pairs
-from ..core.variables import KIND_VARIABLE, TIME, Parameter, StateSelect, Symbol, Variable
+from ..core.expr import Equation
+from ..core.variables import TIME, Output, Parameter, StateSelect, Symbol, Variable
 
 #: the array path is used from this many scalar equations on
 ARRAY_PATH_FROM = 1000
@@ -72,9 +72,9 @@ def collect(model: Any, minimum: int | None = None) -> Collected | str:
     is_var_run = []
     for start, _, _ in runs:
         kind = type(symbols[start].decl)
-        if kind not in (Variable, Parameter):
+        if kind not in (Variable, Output, Parameter):
             return f"{symbols[start].name} is a {kind.__name__}"
-        is_var_run.append(kind is Variable)
+        is_var_run.append(kind is not Parameter)
     variables = list(chain.from_iterable(symbols[a:a + n] for (a, n, _), v in
                                          zip(runs, is_var_run, strict=True) if v))
     params = list(chain.from_iterable(symbols[a:a + n] for (a, n, _), v in
@@ -255,31 +255,3 @@ class _Positions(dict):
         self.update(zip(map(id, self.symbols), self.column.tolist(), strict=True))
         self.symbols = None
         return self[key]
-
-
-def _is_variable(sym: Any) -> bool:
-    decl = getattr(sym, "decl", None)
-    return decl is not None and decl.kind == KIND_VARIABLE and sym.der_of is None
-
-
-def _is_alias_array(eq: ArrayEquation) -> bool:
-    pairs = alias_pairs(eq)
-    if pairs is None:
-        return False
-    _, _, a, b = pairs
-    return bool(a.size) and _is_variable(a[0].sym) and _is_variable(b[0].sym)
-
-
-def _is_alias_scalar(eq: Equation) -> bool:
-    leaves: list = []
-    consts: list = []
-    shapes = []
-    for side in (eq.lhs, eq.rhs):
-        if isinstance(side, (Leaf, Op)):
-            shapes.append(shape_of(side, leaves, consts))
-        else:
-            consts.append(side)
-            shapes.append("C")
-    if not alias_signs(*shapes) or any(np.asarray(c, dtype=float) != 0.0 for c in consts):
-        return False
-    return all(_is_variable(s) for s in leaves)

@@ -396,3 +396,43 @@ def test_alias_cycles_and_conflicts_go_the_scalar_way():
     assert "cycle" in why_not(LoopedAliases(), minimum=0)
     conflicting = Aliased(3, x={"start": 5.0, "fixed": True})
     assert "conflicting" in why_not(conflicting, minimum=0)
+
+
+class Measured(Component):
+    """``der(x) = -k*x`` with the outputs ``y = 3*x`` (an array) and ``total = x[1] + x[n]``
+    and the alias output ``copy = x``."""
+
+    x = Variable(shape="n", start=1.0, fixed=True)
+    y = bg.Output(shape="n")
+    copy = bg.Output(shape="n")
+    total = bg.Output()
+    k = Parameter(2.0)
+
+    def __init__(self, n: int = 3, **modifiers):
+        self.n = n
+        super().__init__(**modifiers)
+
+    def equations(self):
+        yield der(self.x) == -self.k * self.x
+        yield self.y == 3.0 * self.x
+        yield self.copy == self.x
+        yield self.total == self.x[0] + self.x[-1]
+
+
+def test_outputs_take_the_array_path_and_export(tmp_path):
+    from fmpy import read_model_description
+
+    from bgmodelica.fmi.from_model import export_model
+
+    fast = compile_arrays(Measured(3), minimum=0)
+    assert isinstance(fast, ArrayCompiledModel)
+    slow = _compile(Measured(3), None)
+    assert fast.dae.aliases == slow.dae.aliases
+    _same_dae(fast.dae, slow.dae)
+    res = bg.simulate(fast, stop_time=1.0, interval=0.5, **TIGHT)
+    assert res["total"][-1] == pytest.approx(2 * np.exp(-2.0), rel=1e-8)
+    assert res["copy[3]"][-1] == pytest.approx(np.exp(-2.0), rel=1e-8)
+    fmu = export_model(fast, tmp_path)
+    outputs = {v.name for v in read_model_description(str(fmu)).modelVariables
+               if v.causality == "output"}
+    assert {"y[1]", "y[3]", "total"} <= outputs
