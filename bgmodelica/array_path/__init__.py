@@ -168,13 +168,14 @@ class ArrayCompiledModel(CompiledModel):
 
 
 class Declarations:
-    """The variables and parameters of a model compiled by the array path, as simulation
-    reads them from a flat model (names, declarations; no aliases, inputs or discretes)."""
+    """The variables, parameters and inputs of a model compiled by the array path, and its
+    aliases, as simulation reads them from a flat model (names, declarations; no
+    discretes)."""
 
     def __init__(self, compiled: ArrayCompiledModel) -> None:
         self.name = compiled.name
         self.variables = compiled.__dict__["_variables"]
         self.parameters = compiled.dae.parameters
-        self.inputs: list[Any] = []
+        self.inputs = compiled.dae.inputs
         self.discretes: list[Any] = []
         self.aliases: dict[str, tuple[str, float]] = compiled.dae.aliases

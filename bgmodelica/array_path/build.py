@@ -99,11 +99,13 @@ def assemble(col: Collected, low: Lowered, solved: ca.MX, states: np.ndarray,
     parameters = list(map(FlatVariable, map(_NAME, col.params), repeat(None),
                           map(_DECL, col.params), repeat(""), repeat(-1), repeat(-1),
                           zip(repeat(column), range(n_x, n_x + n_p))))
+    n_free = n_p - col.n_inputs                 # parameters, then the inputs
+    parameters, inputs = parameters[:n_free], parameters[n_free:]
     return CasadiDAE(
         x=x, z=ca.SX(0, 1), p=p if n_p else ca.SX(0, 1),
         t=TIME.sx, ode=ode, alg=ca.SX(0, 1), observed=observed,
         names=names, state_names=[names[k] for k in state_pos], algebraic_names=[],
-        parameters=parameters, inputs=[],
+        parameters=parameters, inputs=inputs,
         x_start=np.fromiter(map(float, map(starts.__getitem__, state_pos)), float, n_x),
         z_start=np.zeros(0), fixed=fixed,
         observed_index=dict(zip(names, range(len(names)), strict=True)),

@@ -6,8 +6,9 @@ is the one the scalar pipeline gives; anything else goes the usual way:
 
 - one component, without subcomponents, connectors, connections or initial equations;
 - plain :class:`~bgmodelica.core.variables.Variable` and
-  :class:`~bgmodelica.core.variables.Output` (default state selection) and
-  :class:`~bgmodelica.core.variables.Parameter` declarations, parameters given as numbers;
+  :class:`~bgmodelica.core.variables.Output` (default state selection),
+  :class:`~bgmodelica.core.variables.Parameter` and
+  :class:`~bgmodelica.core.variables.Input` declarations, parameters given as numbers;
 - equations that are array equations lowered as blocks, or a few scalar equations, built
   from whole-array arithmetic and the smooth math functions (no relations, events or
   ``if_else``); aliases ``a == b`` between variables are eliminated as the scalar pipeline
@@ -28,7 +29,7 @@ import numpy as np
 from ..core.arrays import ArrayEquation, _block_operand
 from ..core.component import Component, _own_methods
 from ..core.expr import Equation
-from ..core.variables import TIME, Output, Parameter, StateSelect, Symbol, Variable
+from ..core.variables import TIME, Input, Output, Parameter, StateSelect, Symbol, Variable
 
 #: the array path is used from this many scalar equations on
 ARRAY_PATH_FROM = 1000
@@ -41,7 +42,9 @@ class Collected:
     """A model the array path takes: ``order`` holds its variables in the order of the
     scalar pipeline (each variable followed by its time derivative, if used), ``params`` its
     parameters in declaration order; ``equations`` are the equations and ``n_rows`` their
-    number of scalar equations. ``pos`` maps ``id(symbol)`` to its column (variables and
+    number of scalar equations; the last ``n_inputs`` of ``params`` are the model's inputs
+    (:class:`~bgmodelica.core.variables.Input`, held constant by ``simulate`` unless given
+    as tables). ``pos`` maps ``id(symbol)`` to its column (variables and
     derivatives, then parameters, then time) and ``memo`` the declared arrays to their
     columns (as :func:`~bgmodelica.core.flatten_arrays.residual` reads them)."""
 
@@ -53,6 +56,7 @@ class Collected:
     n_rows: int
     pos: dict[int, int]
     memo: dict[int, Any]
+    n_inputs: int = 0
 
 
 _DECL = attrgetter("decl")
@@ -69,21 +73,24 @@ def collect(model: Any, minimum: int | None = None) -> Collected | str:
     names = list(model._symbols)
     runs = _runs(model, names)
     # the elements of a declared array share their declaration's class
-    is_var_run = []
+    kinds = []
     for start, _, _ in runs:
         kind = type(symbols[start].decl)
-        if kind not in (Variable, Output, Parameter):
+        if kind not in (Variable, Output, Parameter, Input):
             return f"{symbols[start].name} is a {kind.__name__}"
-        is_var_run.append(kind is not Parameter)
-    variables = list(chain.from_iterable(symbols[a:a + n] for (a, n, _), v in
-                                         zip(runs, is_var_run, strict=True) if v))
-    params = list(chain.from_iterable(symbols[a:a + n] for (a, n, _), v in
-                                      zip(runs, is_var_run, strict=True) if not v))
+        kinds.append(kind)
+
+    def of_kind(*wanted: type) -> list[Symbol]:
+        return list(chain.from_iterable(symbols[a:a + n] for (a, n, _), kind in
+                                        zip(runs, kinds, strict=True) if kind in wanted))
+
+    variables, params, inputs = of_kind(Variable, Output), of_kind(Parameter), of_kind(Input)
     if set(map(attrgetter("state_select"), map(_DECL, variables))) - {StateSelect.DEFAULT}:
         return "a variable has a state selection"
     if not all(issubclass(t, _NUMBERS) and t is not bool
-               for t in set(map(type, map(attrgetter("value"), map(_DECL, params))))):
-        return "a parameter is not given as a number"
+               for t in set(map(type, map(attrgetter("value"), map(_DECL, params))))
+               | set(map(type, map(attrgetter("start"), map(_DECL, inputs))))):
+        return "a parameter or an input is not given as a number"
     if _own_methods(type(model), "initial_equations") != (Component.initial_equations,) \
             or model.__dict__.get("_initial_equations"):
         return "it has initial equations"        # (not called here: they may make symbols)
@@ -121,10 +128,12 @@ def collect(model: Any, minimum: int | None = None) -> Collected | str:
     var_col = np.arange(len(variables)) + np.cumsum(has_der) - has_der
     ders = list(compress(ders, has_der))
     sizes = np.array([size for _, size, _ in runs], dtype=np.int64)
-    is_var = np.repeat(np.array(is_var_run, dtype=bool), sizes)
+    kind_of = np.repeat(np.array([0 if k in (Variable, Output) else 1 if k is Parameter else 2
+                                  for k in kinds], dtype=np.int8), sizes)
     column = np.empty(len(symbols), dtype=np.int64)
-    column[is_var] = var_col
-    column[~is_var] = n + np.arange(len(params))
+    column[kind_of == 0] = var_col
+    column[kind_of == 1] = n + np.arange(len(params))
+    column[kind_of == 2] = n + len(params) + np.arange(len(inputs))
     pos, memo = _Positions(symbols, column), {}
     for start, _, array in runs:
         if not array:
@@ -137,8 +146,9 @@ def collect(model: Any, minimum: int | None = None) -> Collected | str:
             root = root.base
         memo[id(root)] = (root, column[start:start + int(np.prod(shape))])
     pos.update(zip(map(id, ders), (var_col[has_der] + 1).tolist(), strict=True))
-    pos[id(TIME)] = n + len(params)
-    return Collected(name, where, order, params, equations, n_rows, pos, memo)
+    pos[id(TIME)] = n + len(params) + len(inputs)
+    return Collected(name, where, order, params + inputs, equations, n_rows, pos, memo,
+                     len(inputs))
 
 
 def _first_element(key: str, shape: tuple[int, ...]) -> str:

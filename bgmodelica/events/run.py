@@ -38,7 +38,7 @@ def simulate_hybrid(compiled, dae: CasadiDAE, p: np.ndarray, grid: np.ndarray, *
     names = [dae.names[k] for k in obs_idx]
     kept = set(names)
     aliases = {a: rep for a, rep in dae.aliases.items() if rep[0] in kept}
-    flat = compiled.reduced.model
+    flat = compiled.declarations
     units = {v.name: v.decl.unit for v in flat.variables}
     units.update({d.name: d.decl.unit for d in flat.discretes})
     units.update({q.name: q.decl.unit for q in (*flat.parameters, *flat.inputs)})

@@ -436,3 +436,35 @@ def test_outputs_take_the_array_path_and_export(tmp_path):
     outputs = {v.name for v in read_model_description(str(fmu)).modelVariables
                if v.causality == "output"}
     assert {"y[1]", "y[3]", "total"} <= outputs
+
+
+class Driven(Component):
+    """``der(x) = -k*x + u + g`` with a scalar input ``u`` and an array input ``g``."""
+
+    x = Variable(shape="n", start=0.0, fixed=True)
+    u = bg.Input(start=1.0)
+    g = bg.Input(shape="n", start=0.5)
+    k = Parameter(2.0)
+
+    def __init__(self, n: int = 3, **modifiers):
+        self.n = n
+        super().__init__(**modifiers)
+
+    def equations(self):
+        yield der(self.x) == -self.k * self.x + self.u + self.g
+
+
+def test_inputs_take_the_array_path_held_or_as_tables():
+    fast = compile_arrays(Driven(3), minimum=0)
+    assert isinstance(fast, ArrayCompiledModel)
+    slow = _compile(Driven(3), None)
+    assert [u.name for u in fast.dae.inputs] == [u.name for u in slow.dae.inputs] \
+        == ["u", "g[1]", "g[2]", "g[3]"]
+    _same_dae(fast.dae, slow.dae)
+    res = bg.simulate(fast, stop_time=1.0, interval=0.5, **TIGHT)        # held at start
+    assert res["x[2]"][-1] == pytest.approx(1.5 / 2.0 * (1 - np.exp(-2.0)), rel=1e-8)
+    table = {"u": ([0.0, 1.0], [0.0, 2.0])}                              # u = 2 t
+    res = bg.simulate(fast, stop_time=1.0, interval=0.5, inputs=table, **TIGHT)
+    ref = bg.simulate(slow, stop_time=1.0, interval=0.5, inputs=table, **TIGHT)
+    assert np.max(np.abs(res["x[1]"] - ref["x[1]"])) < 1e-10
+    assert "flat" not in fast.__dict__
