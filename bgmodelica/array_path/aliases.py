@@ -17,7 +17,7 @@ import numpy as np
 from ..core.arrays import ArrayEquation
 from ..core.expr import alias_signs
 from ..core.flatten import _side_shape
-from ..core.flatten_arrays import _rows, _signature
+from ..core.flatten_arrays import _rows, alias_form
 from ..structure.alias import alias_classes
 from .collect import Collected
 
@@ -119,16 +119,15 @@ def _column(pos: Any, sym: Any, n: int) -> int:
 def _array_link(eq: ArrayEquation, col: Collected) -> tuple[np.ndarray, np.ndarray, float] | None:
     """The columns of ``sa*a + sb*b = 0`` between two arrays of leaves, element by element
     (broadcast to the equation's shape), and the factor ``-sb/sa``; None for any other
-    form (:func:`~bgmodelica.core.flatten_arrays.alias_pairs`)."""
-    leaves: list = []
-    consts: list = []
-    signs = alias_signs(_signature(eq.lhs, leaves, consts), _signature(eq.rhs, leaves, consts))
-    if not signs or any(np.any(np.asarray(c) != 0.0) for c in consts):
+    form (:func:`~bgmodelica.core.flatten_arrays.alias_form`)."""
+    form = alias_form(eq)
+    if form is None:
         return None
+    sa, sb, arrays = form
     shape = eq.shape
     a, b = (np.broadcast_to(np.asarray(_rows(arr.items, col.pos, col.memo), dtype=np.int64)
-                            .reshape(arr.shape), shape).ravel() for arr in leaves)
-    return a, b, -signs[1] / signs[0]
+                            .reshape(arr.shape), shape).ravel() for arr in arrays)
+    return a, b, -sb / sa
 
 
 def _ranks(order: list[Any], heads: np.ndarray, tails: np.ndarray) -> list[int]:

@@ -105,18 +105,27 @@ def _rows(items: np.ndarray, pos: dict[int, int], memo: dict[int, Any]) -> list[
     return view.ravel().tolist()
 
 
-def alias_pairs(eq: ArrayEquation) -> tuple[float, float, np.ndarray, np.ndarray] | None:
+def alias_form(eq: ArrayEquation) -> tuple[float, float, list[ArrayExpr]] | None:
     """For ``sa*a + sb*b = 0`` between two arrays of declared scalars (after moving all to
-    one side): ``(sa, sb, leaves of a, leaves of b)``, broadcast to the equation's shape and
-    flattened; None for any other form."""
+    one side): ``(sa, sb, [a, b])``, the two arrays as written; None for any other form."""
     leaves: list = []
     consts: list = []
     signs = alias_signs(_signature(eq.lhs, leaves, consts), _signature(eq.rhs, leaves, consts))
     if not signs or any(np.any(np.asarray(c) != 0.0) for c in consts):
         return None
+    return signs[0], signs[1], leaves
+
+
+def alias_pairs(eq: ArrayEquation) -> tuple[float, float, np.ndarray, np.ndarray] | None:
+    """:func:`alias_form` with the leaves of ``a`` and ``b`` broadcast to the equation's
+    shape and flattened: ``(sa, sb, leaves of a, leaves of b)``."""
+    form = alias_form(eq)
+    if form is None:
+        return None
+    sa, sb, arrays = form
     shape = eq.shape
-    a, b = (np.broadcast_to(arr.items, shape).ravel() for arr in leaves)
-    return signs[0], signs[1], a, b
+    a, b = (np.broadcast_to(arr.items, shape).ravel() for arr in arrays)
+    return sa, sb, a, b
 
 
 def _signature(x: Any, leaves: list, consts: list) -> Any:
