@@ -133,7 +133,7 @@ def cmd_check(args: argparse.Namespace) -> int:
 
     model = load_model(args.model, **_model_kwargs(args.arg))
     compiled = compile(model, units=args.units, cache=args.cache)
-    check_values(compiled.dae, compiled.dae.p_default, compiled.reduced.model)
+    check_values(compiled.dae, compiled.dae.p_default, compiled.declarations)
     summary = compiled.summary()
     extra = _bondgraph_report(model)
     if extra is not None:

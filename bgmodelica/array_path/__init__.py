@@ -166,6 +166,27 @@ class ArrayCompiledModel(CompiledModel):
     def has_state_choice(self) -> bool:
         return False
 
+    def summary(self) -> dict[str, Any]:
+        """:meth:`CompiledModel.summary` read off the array path's result (the scalar
+        structures are not needed): an explicit ODE, every algebraic variable solved."""
+        if "reduced" in self.__dict__:
+            return super().summary()
+        dae = self.dae
+        n = len(dae.names) - len(dae.state_names)       # unknowns: derivatives, algebraics
+        algebraic = any(v.der is None and v.der_of is None
+                        for v in self.__dict__["_variables"])
+        return {
+            "model": self.name, "equations": n, "unknowns": n, "balanced": True,
+            "flat_equations_before_alias_elimination": self.n_flat_equations,
+            "aliases_eliminated": len(dae.aliases),
+            "structural_index": 1 if algebraic else 0,   # Pryce's: algebraic variables add 1
+            "differentiated_equations": [], "states": list(dae.state_names),
+            "dummy_derivatives": [], "algebraic_variables": [], "algebraic_loops": [],
+            "dynamic_state_selection": False, "parameters": len(dae.parameters),
+            "inputs": [u.name for u in dae.inputs], "events": None,
+            "compile_seconds": dict(self.timings),
+        }
+
 
 class Declarations:
     """The variables, parameters and inputs of a model compiled by the array path, and its

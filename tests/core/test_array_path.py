@@ -95,8 +95,10 @@ def test_the_scalar_structures_are_made_on_first_use():
     bg.simulate(compiled, stop_time=0.01)                # simulation does not need them
     assert "flat" not in compiled.__dict__
     before = compiled.dae
-    summary = compiled.summary()                          # `check` does
+    summary = compiled.summary()                          # read off the array path
     assert summary["equations"] == 2400 and len(summary["states"]) == 1200
+    assert "flat" not in compiled.__dict__
+    assert len(compiled.flat.variables) == 3600           # made when read
     assert compiled.timings["scalar_structures"] > 0
     assert compiled.dae is not before and compiled.dae.names == before.names
     assert len(compiled.flat.variables) == 3600
@@ -330,7 +332,7 @@ def test_a_component_changed_after_compile_is_refused_when_completing():
     compiled = bg.compile(model)
     model.modify(V=5.0)
     with pytest.raises(ModelError, match="modified after compile"):
-        compiled.summary()
+        compiled.flat  # noqa: B018
 
 
 def test_the_array_path_can_be_turned_off():
@@ -468,3 +470,15 @@ def test_inputs_take_the_array_path_held_or_as_tables():
     ref = bg.simulate(slow, stop_time=1.0, interval=0.5, inputs=table, **TIGHT)
     assert np.max(np.abs(res["x[1]"] - ref["x[1]"])) < 1e-10
     assert "flat" not in fast.__dict__
+
+
+@pytest.mark.parametrize("make", [lambda: RCLadderVector(3), lambda: Aliased(3),
+                                  lambda: Driven(3), lambda: Measured(3), lambda: Mixed()])
+def test_the_summary_equals_the_scalar_pipelines_without_building_it(make):
+    fast = compile_arrays(make(), minimum=0)
+    mine = fast.summary()
+    assert "flat" not in fast.__dict__
+    theirs = _compile(make(), None).summary()
+    for summary in (mine, theirs):
+        summary.pop("compile_seconds")
+    assert mine == theirs
