@@ -16,7 +16,7 @@ import casadi as ca
 import numpy as np
 
 from ..core.arrays import ArrayEquation, ArrayExpr
-from ..core.expr import Expr, Leaf, apply_op
+from ..core.expr import Expr, apply_op, lower_tree
 from ..core.flatten_arrays import _rows
 from .collect import Collected
 
@@ -114,21 +114,9 @@ class Lowered:
 
     def _scalar(self, e: Any, leaves: list[int]) -> Any:
         """A scalar expression tree as MX (its leaves' columns appended to ``leaves``)."""
-        memo: dict[int, Any] = {}
+        def leaf(sym: Any) -> ca.MX:
+            k = self.pos.of(sym)
+            leaves.append(k)
+            return self.all[k]
 
-        def go(node: Any) -> Any:
-            if isinstance(node, (float, int)):
-                return float(node)
-            key = id(node)
-            if key in memo:
-                return memo[key]
-            if isinstance(node, Leaf):
-                k = self.pos.of(node.sym)
-                leaves.append(k)
-                out = self.all[k]
-            else:
-                out = apply_op(node.op, [go(a) for a in node.args])
-            memo[key] = out
-            return out
-
-        return go(e)
+        return lower_tree(e, leaf)

@@ -253,17 +253,22 @@ def to_sx(e: Any, leaf_sx: Callable[[Any], ca.SX] | None = None) -> Any:
         return ca.SX(float(e))
     if not isinstance(e, Expr):
         raise TypeError(f"cannot use {e!r} in an expression")
-    leaf_sx = leaf_sx or (lambda sym: sym.sx)
+    return ca.SX(lower_tree(e, leaf_sx or (lambda sym: sym.sx)))
+
+
+def lower_tree(e: Any, leaf: Callable[[Any], Any]) -> Any:
+    """An expression tree as CasADi operations on what ``leaf(symbol)`` gives for its leaves
+    (SX or MX); shared subtrees are lowered once, numbers stay floats."""
     memo: dict[int, Any] = {}
 
     def go(node: Any) -> Any:
-        if isinstance(node, float):
-            return node
+        if isinstance(node, (float, int)):
+            return float(node)
         key = id(node)
         if key in memo:
             return memo[key]
         if isinstance(node, Leaf):
-            out = leaf_sx(node.sym)
+            out = leaf(node.sym)
         elif isinstance(node, Expr):
             out = apply_op(node.op, [go(a) for a in node.args])
         else:
@@ -271,7 +276,7 @@ def to_sx(e: Any, leaf_sx: Callable[[Any], ca.SX] | None = None) -> Any:
         memo[key] = out
         return out
 
-    return ca.SX(go(e))
+    return go(e)
 
 
 def shape_of(e: Any, leaves: list, consts: list) -> Any:
