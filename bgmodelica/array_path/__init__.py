@@ -19,7 +19,8 @@ the scalar pipeline on first use (:class:`ArrayCompiledModel`), and their time i
 from __future__ import annotations
 
 import time as _time
-from typing import Any
+from operator import attrgetter
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -50,7 +51,8 @@ def compile_arrays(model: Any, units: str = "error",
 
 
 def _build(model: Any, units: str, minimum: int | None) -> ArrayCompiledModel | str:
-    from ..passes.units import check_equations
+    from ..errors import UnitError
+    from ..passes.units import check_equations, check_sources
 
     timings: dict[str, float] = {}
     lap = Laps(timings)
@@ -58,7 +60,13 @@ def _build(model: Any, units: str, minimum: int | None) -> ArrayCompiledModel | 
     if isinstance(col, str):
         return col
     lap("collect")
-    check_equations(col.equations, col.where, units)
+    if col.sources is None:
+        check_equations(col.equations, col.where, units)
+    elif units != "off":
+        try:
+            check_sources(col.sources, "error")
+        except UnitError:
+            return "a unit error (the scalar pipeline names it)"
     lap("units")
     try:
         found = _compile_blocks(col, lap)
@@ -66,11 +74,13 @@ def _build(model: Any, units: str, minimum: int | None) -> ArrayCompiledModel | 
         return f"{type(err).__name__}: {err}"
     if isinstance(found, str):
         return found
-    variables = col.order
+    kept = range(len(col.order))
     if found.aliases:
-        variables = [v for v in col.order if v.name not in found.aliases]
+        kept = [k for k, name in enumerate(col.names) if name not in found.aliases]
+    variables = [col.order[k] for k in kept]
+    names = [col.names[k] for k in kept] if col.scoped else None
     return ArrayCompiledModel.made(col.name, found, col.n_rows, timings, model, units,
-                                   variables)
+                                   variables, names)
 
 
 def _compile_blocks(col: Any, lap: Any) -> Any:
@@ -116,11 +126,14 @@ class ArrayCompiledModel(CompiledModel):
 
     @classmethod
     def made(cls, name: str, dae: Any, n_equations: int, timings: dict[str, float],
-             source: Any, units: str, variables: list[Any]) -> ArrayCompiledModel:
+             source: Any, units: str, variables: list[Any],
+             names: list[str] | None = None) -> ArrayCompiledModel:
+        """``variables``: the symbols of the variables left, ``names`` their dotted names
+        (None: the symbols' own names are)."""
         self = object.__new__(cls)
         self.__dict__.update(name=name, dae=dae, n_flat_equations=n_equations,
                              timings=timings, source=source, _units=units,
-                             _variables=variables)
+                             _variables=variables, _names=names)
         return self
 
     def __getattr__(self, attr: str) -> Any:
@@ -188,6 +201,16 @@ class ArrayCompiledModel(CompiledModel):
         }
 
 
+_DECL = attrgetter("decl")
+
+
+class Declared(NamedTuple):
+    """A variable as simulation reads it: dotted name and declaration."""
+
+    name: str
+    decl: Any
+
+
 class Declarations:
     """The variables, parameters and inputs of a model compiled by the array path, and its
     aliases, as simulation reads them from a flat model (names, declarations; no
@@ -196,6 +219,9 @@ class Declarations:
     def __init__(self, compiled: ArrayCompiledModel) -> None:
         self.name = compiled.name
         self.variables = compiled.__dict__["_variables"]
+        names = compiled.__dict__.get("_names")
+        if names is not None:
+            self.variables = list(map(Declared, names, map(_DECL, self.variables)))
         self.parameters = compiled.dae.parameters
         self.inputs = compiled.dae.inputs
         self.discretes: list[Any] = []

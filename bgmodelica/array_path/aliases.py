@@ -10,6 +10,8 @@ goes the scalar way.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import repeat
+from operator import attrgetter, is_not, methodcaller
 from typing import Any
 
 import numpy as np
@@ -20,6 +22,9 @@ from ..core.flatten import _side_shape
 from ..core.flatten_arrays import _rows, alias_form
 from ..structure.alias import alias_classes
 from .collect import Collected
+from .connections import LinearRows
+
+_DECL, _DER = attrgetter("decl"), attrgetter("der")
 
 
 @dataclass
@@ -50,18 +55,21 @@ def find_aliases(col: Collected) -> Aliases | str | None:
     factors: list[np.ndarray] = []
     linked_rows: dict[int, np.ndarray] = {}   # equation -> which of its rows are links
 
-    def add(k: int, a: np.ndarray, b: np.ndarray, factor: float) -> None:
+    def add(k: int, a: np.ndarray, b: np.ndarray, factor: float | np.ndarray) -> None:
         ok = plain[a] & plain[b] & (a != b)
         linked_rows[k] = ok
         heads.append(a[ok])
         tails.append(b[ok])
-        factors.append(np.full(int(ok.sum()), factor))
+        factors.append(np.broadcast_to(factor, a.shape)[ok].astype(float))
 
-    # the scalar pipeline's order: scalar equations grouped by shape (first seen first),
-    # then the array equations
+    # the scalar pipeline's order: connection sets, scalar equations grouped by shape (first
+    # seen first), then the array equations
+    for k, eq in enumerate(col.equations):
+        if isinstance(eq, LinearRows) and eq.links is not None:
+            add(k, *eq.links)
     groups: dict[Any, list[tuple[int, list, list]]] = {}
     for k, eq in enumerate(col.equations):
-        if not isinstance(eq, ArrayEquation):
+        if not isinstance(eq, (ArrayEquation, LinearRows)):
             leaves: list = []
             consts: list = []
             key = (_side_shape(eq.lhs, leaves, consts), _side_shape(eq.rhs, leaves, consts))
@@ -90,7 +98,8 @@ def find_aliases(col: Collected) -> Aliases | str | None:
         elif ok.any():
             return "an array equation is partly of aliases"
     links = list(zip(links_a.tolist(), links_b.tolist(), signs_.tolist(), strict=True))
-    classes = alias_classes(n, links, _ranks(order, links_a, links_b))
+    names_of = col.names
+    classes = alias_classes(n, links, _ranks(order, names_of, links_a, links_b))
     if classes.redundant:
         return "alias equations close a cycle"
     rep = np.asarray(classes.rep, dtype=np.int64)
@@ -102,7 +111,7 @@ def find_aliases(col: Collected) -> Aliases | str | None:
         return starts
     keep = np.ones(n, dtype=bool)
     keep[members] = False
-    names = {order[i].name: (order[classes.rep[i]].name, classes.sign[i]) for i in members}
+    names = {names_of[i]: (names_of[classes.rep[i]], classes.sign[i]) for i in members}
     return Aliases(np.flatnonzero(keep), rep, np.asarray(classes.sign, dtype=float), dropped,
                    names, starts)
 
@@ -130,20 +139,29 @@ def _array_link(eq: ArrayEquation, col: Collected) -> tuple[np.ndarray, np.ndarr
     return a, b, -sb / sa
 
 
-def _ranks(order: list[Any], heads: np.ndarray, tails: np.ndarray) -> list[int]:
+def _ranks(order: list[Any], names: list[str], heads: np.ndarray,
+           tails: np.ndarray) -> list[int]:
     """:func:`bgmodelica.passes.alias._ranks` on the collected columns: the dense rank of
     (has a derivative, state priority, fixed start, fewer dots, shorter name) among the
     linked variables, 0 for the others."""
     linked = np.unique(np.concatenate([heads, tails]))
-    syms = [order[i] for i in linked.tolist()]
-    keys = list(zip((s.der is not None for s in syms),
-                    (int(getattr(s.decl, "state_select", 0)) for s in syms),
-                    (bool(getattr(s.decl, "fixed", False)) for s in syms),
-                    (-s.name.count(".") for s in syms), (-len(s.name) for s in syms),
-                    strict=True))
-    dense = {key: k for k, key in enumerate(sorted(set(keys)))}
+    at = linked.tolist()
+    syms = [order[i] for i in at]
+    decls = list(map(_DECL, syms))
+    texts = [names[i] for i in at]
+    keys = np.column_stack((
+        np.fromiter(map(is_not, map(_DER, syms), repeat(None)), np.int64, len(at)),
+        np.fromiter((int(getattr(d, "state_select", 0)) for d in decls), np.int64, len(at)),
+        np.fromiter((bool(getattr(d, "fixed", False)) for d in decls), np.int64, len(at)),
+        -np.fromiter(map(methodcaller("count", "."), texts), np.int64, len(at)),
+        -np.fromiter(map(len, texts), np.int64, len(at))))
+    keys -= keys.min(axis=0)                 # one integer, ordered as the tuples are
+    code = np.zeros(len(at), dtype=np.int64)
+    for column in keys.T:
+        code = code * (int(column.max()) + 1) + column
+    _, dense = np.unique(code, return_inverse=True)
     out = np.zeros(len(order), dtype=np.int64)
-    out[linked] = [dense[key] for key in keys]
+    out[linked] = dense.ravel()
     return out.tolist()
 
 
@@ -153,9 +171,14 @@ def _merged_starts(order: list[Any], rep: list[int], sign: list[float],
     start carried to its representative (a conflict is left to the scalar pipeline, which
     names it), or a nonzero guess to a representative starting at 0 without a fixed one."""
     current: dict[int, tuple[float, bool]] = {}
-    for i in members:
+    decls = list(map(_DECL, (order[i] for i in members)))
+    # only members with a fixed or nonzero start change their representative's start
+    matter = np.flatnonzero(np.fromiter(map(attrgetter("fixed"), decls), bool, len(decls))
+                            | (np.fromiter(map(attrgetter("start"), decls), float,
+                                           len(decls)) != 0))
+    for k in matter.tolist():
+        i, dv = members[k], decls[k]
         r = rep[i]
-        dv = order[i].decl
         r_start, r_fixed = current.get(r, (float(order[r].decl.start), bool(order[r].decl.fixed)))
         if dv.fixed:
             start = sign[i] * dv.start

@@ -35,9 +35,12 @@ def solve_blocks(low: Lowered, order: ExplicitOrder, unknown: np.ndarray) -> ca.
     n = low.n
     starts = np.concatenate([[0], np.cumsum(low.sizes)]).astype(np.int64)
     current = low.x
-    for b in order.blocks:
+    for b, rows in order.steps():
         r = low.blocks[b]
-        mine = unknown[order.unknown_of[starts[b]:starts[b + 1]]]
+        here = np.arange(starts[b], starts[b + 1]) if rows is None else starts[b] + rows
+        if rows is not None:
+            r = r[rows.tolist()]
+        mine = unknown[order.unknown_of[here]]
         seed = ca.DM(_column(n, np.sort(mine)), 1.0)
         coefficient = ca.jtimes(r, low.x, seed)
         if coefficient.nnz() != r.numel():
@@ -81,7 +84,7 @@ def assemble(col: Collected, low: Lowered, solved: ca.MX, states: np.ndarray,
         both = ca.cse(ca.vertcat(ode, observed))
         ode, observed = both[:n_x], both[n_x:]
     kept_vars = order if aliases is None else [order[j] for j in kept]
-    names = list(map(_NAME, kept_vars))
+    names = col.names if aliases is None else [col.names[j] for j in kept]
     decls = list(map(_DECL, kept_vars))
     merged = aliases.starts if aliases is not None else {}
     if merged:                                   # representatives given an alias's start
@@ -96,8 +99,9 @@ def assemble(col: Collected, low: Lowered, solved: ca.MX, states: np.ndarray,
     fixed = [(k, float(starts[k])) for k in compress(range(len(kept)), flags)]
     position = dict(zip(kept, range(len(kept)), strict=True)) if aliases is not None else None
     state_pos = state_list if position is None else [position[j] for j in state_list]
-    parameters = list(map(FlatVariable, map(_NAME, col.params), repeat(None),
-                          map(_DECL, col.params), repeat(""), repeat(-1), repeat(-1),
+    owners = repeat("") if col.param_owners is None else col.param_owners
+    parameters = list(map(FlatVariable, col.param_names, repeat(None),
+                          map(_DECL, col.params), owners, repeat(-1), repeat(-1),
                           zip(repeat(column), range(n_x, n_x + n_p))))
     n_free = n_p - col.n_inputs                 # parameters, then the inputs
     parameters, inputs = parameters[:n_free], parameters[n_free:]

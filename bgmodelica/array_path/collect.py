@@ -19,7 +19,7 @@ is the one the scalar pipeline gives; anything else goes the usual way:
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from itertools import chain, compress, repeat
 from operator import attrgetter, is_not
 from typing import Any
@@ -44,7 +44,10 @@ class Collected:
     parameters in declaration order; ``equations`` are the equations and ``n_rows`` their
     number of scalar equations; the last ``n_inputs`` of ``params`` are the model's inputs
     (:class:`~bgmodelica.core.variables.Input`, held constant by ``simulate`` unless given
-    as tables). ``pos`` maps ``id(symbol)`` to its column (variables and
+    as tables). ``names`` and ``param_names`` are their dotted names (``scoped``: the
+    symbols' own names are not: a model of components), ``param_owners`` the components
+    declaring the parameters (None: the top level); ``sources`` the equations as written
+    with their origins for the unit check (None: all written at ``where``). ``pos`` maps ``id(symbol)`` to its column (variables and
     derivatives, then parameters, then time) and ``memo`` the declared arrays to their
     columns (as :func:`~bgmodelica.core.flatten_arrays.residual` reads them)."""
 
@@ -57,9 +60,19 @@ class Collected:
     pos: dict[int, int]
     memo: dict[int, Any]
     n_inputs: int = 0
+    names: list[str] = field(default_factory=list)
+    param_names: list[str] = field(default_factory=list)
+    param_owners: list[str] | None = None
+    sources: Any = None
+    scoped: bool = False
+
+    def __post_init__(self) -> None:
+        if not self.names:
+            self.names = list(map(_NAME, self.order))
+            self.param_names = list(map(_NAME, self.params))
 
 
-_DECL = attrgetter("decl")
+_DECL, _NAME = attrgetter("decl"), attrgetter("name")
 _NUMBERS = (int, float, np.integer, np.floating)
 
 
@@ -67,8 +80,11 @@ def collect(model: Any, minimum: int | None = None) -> Collected | str:
     """The model's columns and equations, or why it does not take the array path."""
     if not isinstance(model, Component) or type(model) is Component:
         return "not a component class"
+    minimum = ARRAY_PATH_FROM if minimum is None else minimum
     if model._children:
-        return "it has subcomponents"
+        from .components import collect_components
+
+        return collect_components(model, minimum)
     symbols = list(model._symbols.values())
     names = list(model._symbols)
     runs = _runs(model, names)
@@ -94,7 +110,6 @@ def collect(model: Any, minimum: int | None = None) -> Collected | str:
     if _own_methods(type(model), "initial_equations") != (Component.initial_equations,) \
             or model.__dict__.get("_initial_equations"):
         return "it has initial equations"        # (not called here: they may make symbols)
-    minimum = ARRAY_PATH_FROM if minimum is None else minimum
     if len(variables) < minimum:       # a balanced model has one equation per variable
         return "small"
     from ..validate import guarded_equations

@@ -19,6 +19,7 @@ from ..core.arrays import ArrayEquation, ArrayExpr
 from ..core.expr import Expr, apply_op, lower_tree
 from ..core.flatten_arrays import _rows
 from .collect import Collected
+from .connections import LinearRows
 
 
 class Lowered:
@@ -38,6 +39,10 @@ class Lowered:
         cols: list[np.ndarray] = []
         start = 0
         for eq in col.equations:
+            if isinstance(eq, LinearRows):
+                self._linear(eq, start, rows, cols)
+                start += eq.size
+                continue
             shape = eq.shape if isinstance(eq, ArrayEquation) else ()
             size = int(np.prod(shape))
             left, lmaps = self.lower(eq.lhs, shape)
@@ -55,6 +60,16 @@ class Lowered:
             start += size
         self.rows = np.concatenate(rows) if rows else np.zeros(0, dtype=np.int64)
         self.cols = np.concatenate(cols) if cols else np.zeros(0, dtype=np.int64)
+
+    def _linear(self, eq: LinearRows, start: int, rows: list, cols: list) -> None:
+        """Linear rows (connection sets) as one sparse matrix product."""
+        total = self.n + self.n_p + 1
+        matrix = ca.DM.triplet(eq.rows.tolist(), eq.cols.tolist(), ca.DM(eq.coefs.tolist()),
+                               eq.size, total)
+        self.blocks.append(ca.mtimes(matrix, self.all))
+        self.sizes.append(eq.size)
+        rows.append(eq.rows + start)
+        cols.append(eq.cols)
 
     def eliminate(self, dropped: set[int], target: np.ndarray, sign: np.ndarray) -> None:
         """Drop the blocks ``dropped`` (alias equations) and read every column ``k`` of

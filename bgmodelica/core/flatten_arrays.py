@@ -9,6 +9,7 @@ between two arrays of variables are alias links, element by element.
 from __future__ import annotations
 
 from collections.abc import Callable
+from operator import attrgetter
 from typing import Any
 
 import casadi as ca
@@ -78,6 +79,9 @@ class _Lowering:
         return float(x)
 
 
+_SYM = attrgetter("sym")
+
+
 def _rows(items: np.ndarray, pos: dict[int, int], memo: dict[int, Any]) -> list[int]:
     """Rows of an array of declared scalars (C order). A declared array's rows are read
     once; a slice or transpose of it (a numpy view) takes its rows by the same offset and
@@ -91,8 +95,8 @@ def _rows(items: np.ndarray, pos: dict[int, int], memo: dict[int, Any]) -> list[
     hit = memo.get(id(base))
     if hit is None:
         try:
-            rows = np.fromiter((pos[id(leaf.sym)] for leaf in base.ravel()), np.int64,
-                               base.size)
+            rows = np.fromiter(map(pos.__getitem__, map(id, map(_SYM, base.ravel()))),
+                               np.int64, base.size)
         except (KeyError, AttributeError):        # not all of the base is declared scalars
             rows = None
         hit = memo[id(base)] = (base, rows)       # holding base keeps its id unique

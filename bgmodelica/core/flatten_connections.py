@@ -149,10 +149,19 @@ def connection_sets(n: int, heads: list[int], tails: list[int],
     Sets come in the order of their first node in the sequence ``heads[0], tails[0],
     heads[1], ...`` followed by the inside nodes; each set's nodes by their connectors'
     ``paths``, then in that sequence."""
+    nodes, cuts = connection_set_arrays(n, heads, tails, paths)
+    return [part.tolist() for part in np.split(nodes, cuts)] if n else []
+
+
+def connection_set_arrays(n: int, heads: Any, tails: Any,
+                          paths: list[str]) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`connection_sets` as two arrays: the nodes of all sets one after the other,
+    and where each set but the first starts."""
     if n == 0:
-        return []
-    seq = np.concatenate((np.column_stack((np.asarray(heads, dtype=np.int64),
-                                           np.asarray(tails, dtype=np.int64))).ravel(),
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    heads = np.asarray(heads, dtype=np.int64)
+    tails = np.asarray(tails, dtype=np.int64)
+    seq = np.concatenate((np.column_stack((heads, tails)).ravel(),
                           2 * np.arange(n, dtype=np.int64)))
     nodes, first = np.unique(seq, return_index=True)           # present nodes, first seen
     graph = sp.coo_matrix((np.ones(len(heads)), (heads, tails)), shape=(2 * n, 2 * n))
@@ -164,8 +173,7 @@ def connection_sets(n: int, heads: list[int], tails: list[int],
     by_path[sorted(range(n), key=paths.__getitem__)] = np.arange(n)
     order = np.lexsort((first, by_path[nodes >> 1], set_first[label]))
     nodes, label = nodes[order], label[order]
-    cuts = np.flatnonzero(label[1:] != label[:-1]) + 1
-    return [part.tolist() for part in np.split(nodes, cuts)]
+    return nodes, np.flatnonzero(label[1:] != label[:-1]) + 1
 
 
 def _symbol(x: Any) -> Symbol:

@@ -45,12 +45,16 @@ _SYM, _DECL, _UNIT = attrgetter("sym"), attrgetter("decl"), attrgetter("unit")
 class _View:
     """Elements of one class seen as one: attributes are arrays of the elements' ones."""
 
-    __slots__ = ("_items",)
+    __slots__ = ("_items", "_seen")
 
     def __init__(self, items: list[Any]) -> None:
         object.__setattr__(self, "_items", items)
+        object.__setattr__(self, "_seen", {})     # name -> array or view, made once
 
     def __getattr__(self, name: str) -> Any:
+        seen = self._seen.get(name)
+        if seen is not None:
+            return seen
         items = self._items
         cls = type(items[0])
         owner = inspect.getattr_static(cls, name, None)
@@ -71,16 +75,18 @@ class _View:
             raise _Varies(name) from None
         first = values[0]
         if isinstance(first, Leaf):
-            if not all(isinstance(v, Leaf) for v in values):
+            if set(map(type, values)) != {Leaf}:
                 raise _Varies(name)
             arr = np.empty(len(values), dtype=object)
             arr[:] = values
             decls = list(map(_DECL, map(_SYM, values)))
             mark_leaves(arr, len(set(zip(map(type, decls), map(_UNIT, decls),
                                          strict=True))) == 1)
-            return ArrayExpr(arr)
+            found = self._seen[name] = ArrayExpr(arr)
+            return found
         if isinstance(first, Connector):
-            return _View(values)
+            found = self._seen[name] = _View(values)
+            return found
         if isinstance(first, _PLAIN) and all(type(v) is type(first) and v == first
                                              for v in values):
             return first

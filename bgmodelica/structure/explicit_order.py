@@ -5,9 +5,13 @@ array equation), solves explicitly block by block when
 
 - it has a perfect matching of equations to unknowns (each equation solved for one unknown);
 - its block-lower-triangular form has only 1x1 blocks (no algebraic loop);
-- no equation uses an unknown solved by another equation of its own block (a block is then
-  one whole-vector operation: ``i[2:n] = (v[1:n-1] - v[2:n]) / R[2:n]``, not a recurrence);
 - the blocks depend on each other without a cycle.
+
+A block is solved as whole-vector operations: ``i[2:n] = (v[1:n-1] - v[2:n]) / R[2:n]`` is
+one. Where equations of a block use unknowns solved by others of the same block (a sum of
+currents using the currents of the other nodes, a short recurrence), the block is split into
+*levels*: the equations using none of their block's unknowns first, then those using only
+these, and so on, at most :data:`MAX_LEVELS` of them (a longer recurrence is refused).
 
 A system with only 1x1 blocks has a single perfect matching, so the answer does not depend on
 the matching found. The work is done on sparse integer arrays (scipy's compiled matching and
@@ -22,13 +26,24 @@ from dataclasses import dataclass
 import numpy as np
 
 
+#: a block is split into at most this many levels (each is one vector operation)
+MAX_LEVELS = 64
+
+
 @dataclass
 class ExplicitOrder:
     """``unknown_of[r]``: the unknown equation ``r`` is solved for; ``blocks``: the block
-    indices in solve order (each after the blocks whose unknowns it uses)."""
+    indices in solve order (each after the blocks whose unknowns it uses); ``rows[k]``: the
+    rows of ``blocks[k]`` solved at that step (offsets in the block), None for all of them
+    (a block split into levels comes once per level)."""
 
     unknown_of: np.ndarray
     blocks: list[int]
+    rows: list[np.ndarray | None] | None = None
+
+    def steps(self) -> list[tuple[int, np.ndarray | None]]:
+        """``(block, rows)`` in solve order."""
+        return list(zip(self.blocks, self.rows or [None] * len(self.blocks), strict=True))
 
 
 def explicit_order(n: int, rows: np.ndarray, cols: np.ndarray,
@@ -60,16 +75,47 @@ def explicit_order(n: int, rows: np.ndarray, cols: np.ndarray,
     if n_scc != n:
         return f"{n - n_scc} more unknowns than 1x1 blocks: an algebraic loop"
     block_of = np.repeat(np.arange(len(block_sizes)), block_sizes)
-    b_row, b_src = block_of[rows], block_of[source]
-    if ((b_row == b_src) & (rows != source)).any():
-        return "an equation uses an unknown solved by another row of its own block"
+    inner = (block_of[rows] == block_of[source]) & (rows != source)
+    level = _levels(n, rows[inner], source[inner])
+    if level is None:
+        return (f"an equation uses an unknown solved by another row of its own block, over "
+                f"more than {MAX_LEVELS} levels (a recurrence)")
+    n_levels = int(level.max()) + 1
+    step_of = block_of * n_levels + level
+    steps, step_of = np.unique(step_of, return_inverse=True)      # (block, level) in order
+    b_row, b_src = step_of[rows], step_of[source]
     cross = b_row != b_src
-    n_blocks = len(block_sizes)
-    edges = np.unique(b_src[cross] * n_blocks + b_row[cross])
-    order = _topological(n_blocks, edges // n_blocks, edges % n_blocks)
+    n_steps = steps.size
+    edges = np.unique(b_src[cross] * n_steps + b_row[cross])
+    order = _topological(n_steps, edges // n_steps, edges % n_steps)
     if order is None:
         return "the blocks depend on each other in a cycle"
-    return ExplicitOrder(unknown_of.astype(np.int64), order)
+    blocks = (steps // n_levels)[order].tolist()
+    if n_levels == 1:
+        return ExplicitOrder(unknown_of.astype(np.int64), blocks)
+    starts = np.concatenate(([0], np.cumsum(block_sizes)))
+    split = np.bincount(steps // n_levels, minlength=len(block_sizes)) > 1
+    parts = []
+    for step, b in zip(order, blocks, strict=True):
+        parts.append(np.flatnonzero(step_of[starts[b]:starts[b + 1]] == step)
+                     if split[b] else None)
+    return ExplicitOrder(unknown_of.astype(np.int64), blocks, parts)
+
+
+def _levels(n: int, rows: np.ndarray, sources: np.ndarray) -> np.ndarray | None:
+    """The level of each of ``n`` equations along the edges ``sources[k] -> rows[k]`` (an
+    acyclic graph): 0 without incoming edge, else one more than its highest source; None
+    past :data:`MAX_LEVELS`."""
+    level = np.zeros(n, dtype=np.int64)
+    for _ in range(MAX_LEVELS):
+        if not rows.size:
+            return level
+        want = np.zeros(n, dtype=np.int64)
+        np.maximum.at(want, rows, level[sources] + 1)
+        if (want <= level).all():
+            return level
+        level = np.maximum(level, want)
+    return None
 
 
 def _topological(n: int, before: np.ndarray, after: np.ndarray) -> list[int] | None:

@@ -204,7 +204,7 @@ def test_units_are_checked_on_the_array_path():
 
 
 def test_other_models_say_why_they_go_the_scalar_way():
-    assert why_not(RCLadder(3)) == "it has subcomponents"
+    assert why_not(RCLadder(3)) == "small"
     assert why_not(Decays(10)) == "small"
     assert why_not(Decays(10), minimum=0) is None
     assert "state selection" in why_not(

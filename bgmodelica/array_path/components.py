@@ -1,0 +1,353 @@
+"""Models made of leaf components and connections, on the array path.
+
+A ladder of resistors and capacitors, a discretized line or shaft: a top-level component
+whose subcomponents are leaf components (connectors, no subcomponents of their own), joined
+by ``connect`` statements. Such a model is collected without a Python object per scalar:
+
+- the equations of many components of one class are written once for all of them
+  (:func:`~bgmodelica.core.flatten_vectorized.array_equations`, as the scalar pipeline
+  groups them), the others are asked one by one;
+- the columns follow the scalar pipeline's order (the tree, each variable followed by its
+  derivative), computed per class and per declaration with numpy;
+- the connection sets become linear rows (:mod:`.connections`).
+
+Anything else (subcomponents with subcomponents, signal connections, connectors of the top
+level, initial equations, events) goes the scalar way.
+"""
+
+from __future__ import annotations
+
+from itertools import chain, repeat
+from operator import attrgetter, is_not
+from typing import Any
+
+import numpy as np
+
+from ..core.arrays import ArrayEquation, _block_operand
+from ..core.component import Component, Connection, Connector, _own_methods
+from ..core.expr import Equation
+from ..core.flatmodel import EquationSources
+from ..core.flatten_connections import connection_set_arrays
+from ..core.flatten_vectorized import GROUP_FROM, array_equations, component_groups
+from ..core.variables import (
+    TIME,
+    Flow,
+    Output,
+    Parameter,
+    Potential,
+    StateSelect,
+    Variable,
+)
+from .connections import LinearRows, set_rows
+
+_DECL, _STATE_SELECT = attrgetter("decl"), attrgetter("state_select")
+_VARIABLES = (Variable, Output, Potential, Flow)
+_NUMBERS = (int, float, np.integer, np.floating)
+#: at most this many scalar equations of components asked one by one
+MAX_SCALAR_EQUATIONS = 256
+
+
+def collect_components(model: Component, minimum: int) -> Any:
+    """The :class:`~.collect.Collected` of a model of leaf components, or why it goes the
+    scalar way."""
+    from .collect import Collected
+
+    children = model._children
+    found = _shape_check(model, children, minimum)
+    if found is not None:
+        return found
+    name = model.name or type(model).__name__
+    where = f"top level ({type(model).__name__})"
+    equations = _Equations(model, children, where)
+    if equations.refused is not None:
+        return equations.refused
+    cols = _Columns(children)
+    if cols.refused is not None:
+        return cols.refused
+    rows = _connections(equations.links, cols)
+    if isinstance(rows, str):
+        return rows
+    all_equations = [*rows, *equations.items]
+    n_rows = sum(len(eq) if isinstance(eq, (ArrayEquation, LinearRows)) else 1
+                 for eq in all_equations)
+    if n_rows < minimum:
+        return "small"
+    pos = cols.pos
+    pos[id(TIME)] = cols.n + len(cols.params)
+    sources = EquationSources(groups=_scalar_groups(equations.scalars), arrays=equations.arrays)
+    return Collected(name, where, cols.order, cols.params, all_equations, n_rows, pos, {},
+                     0, cols.names, cols.param_names, cols.param_owners, sources, True)
+
+
+def _shape_check(model: Component, children: dict[str, Any], minimum: int) -> str | None:
+    """Why the tree is not leaf components under a top level of connections (None: it is),
+    or "small"."""
+    if model._symbols:
+        return "it has variables beside subcomponents"
+    if "_arrays" in model.__dict__ and any(not isinstance(c, Component)
+                                           for c in children.values()):
+        return "it has arrays of connectors"
+    initial = (Component.initial_equations,)
+    if _own_methods(type(model), "initial_equations") != initial \
+            or model.__dict__.get("_initial_equations"):
+        return "it has initial equations"
+    size = 0
+    for cls in set(map(type, children.values())):
+        if not issubclass(cls, Component) or cls is Component:
+            return "it has connectors of its own"
+        if _own_methods(cls, "initial_equations") != initial:
+            return "a subcomponent has initial equations"
+    for child in children.values():
+        if child.__dict__.get("_initial_equations"):
+            return "a subcomponent has initial equations"
+        size += len(child._symbols)
+        for sub in child._children.values():
+            if not isinstance(sub, Connector) or sub._children:
+                return "a subcomponent has subcomponents"
+            size += len(sub._symbols)
+    return "small" if size < minimum else None
+
+
+class _Equations:
+    """The model's equations in the scalar pipeline's order: the groups of components
+    written once, then the others' one by one; ``links`` are the top level's connections,
+    ``refused`` says why the model goes the scalar way."""
+
+    def __init__(self, model: Component, children: dict[str, Any], where: str) -> None:
+        from ..validate import guarded_equations
+
+        self.items: list[Any] = []
+        self.scalars: list[tuple[Equation, str]] = []
+        self.arrays: list[tuple[ArrayEquation, str, list[str] | None]] = []
+        self.refused: str | None = None
+        self.links = guarded_equations(model, where, "", blocks=True)
+        if not all(type(c) is Connection and isinstance(c.a, Connector)
+                   and isinstance(c.b, Connector) for c in self.links):
+            self.refused = "the top level has equations other than connections of connectors"
+            return
+        done: set[int] = set()
+        if len(children) >= GROUP_FROM or "_arrays" in model.__dict__:
+            for names, items in component_groups(model):
+                eqs = array_equations(items)
+                if eqs is None:
+                    continue
+                cls = type(items[0]).__name__
+                origin = f"{names[0]} .. {names[-1]} ({len(items)} {cls} components)"
+                wheres = [f"{name} ({cls})" for name in names]
+                self.items.extend(eqs)
+                self.arrays.extend((eq, origin, wheres) for eq in eqs)
+                done.update(map(id, items))
+        for path, child in children.items():
+            if id(child) in done:
+                continue
+            where = f"{path} ({type(child).__name__})"
+            for eq in guarded_equations(child, where, path, blocks=True):
+                if isinstance(eq, ArrayEquation):
+                    self.arrays.append((eq, where, None))
+                elif type(eq) is Equation and _block_operand(eq.lhs) \
+                        and _block_operand(eq.rhs):
+                    self.scalars.append((eq, where))
+                    if len(self.scalars) > MAX_SCALAR_EQUATIONS:
+                        self.refused = "many scalar equations"
+                        return
+                else:
+                    self.refused = f"{where} has an equation that is not smooth arithmetic"
+                    return
+                self.items.append(eq)
+
+
+def _scalar_groups(scalars: list[tuple[Equation, str]]) -> dict[Any, list]:
+    from ..passes.units import _scalar_groups as groups
+
+    return groups([eq for eq, _ in scalars], [where for _, where in scalars])
+
+
+class _Columns:
+    """The columns of a model of leaf components, in the scalar pipeline's order: the tree
+    (each component, then its connectors), each variable followed by its derivative; the
+    parameters after them in the same order. Worked out per class of component and per
+    declaration: ``pos`` (``id(symbol)`` -> column), ``order`` and ``names`` (variables),
+    ``params``, ``param_names`` and ``param_owners``; the connectors numbered in tree order
+    (``connector``: ``id`` -> number, ``paths``, ``kinds``: their variables' names and
+    whether each is a flow, ``columns``: their variables' columns)."""
+
+    def __init__(self, children: dict[str, Any]) -> None:
+        self.refused: str | None = None
+        paths = list(children)
+        items = list(children.values())
+        by_class: dict[Any, list[int]] = {}
+        for k, child in enumerate(items):
+            key = (type(child), tuple(child._symbols), tuple(
+                (name, type(sub), tuple(sub._symbols)) for name, sub in child._children.items()))
+            by_class.setdefault(key, []).append(k)
+        n_children = len(items)
+        counts = np.zeros(n_children, dtype=np.int64)        # columns of each child
+        p_counts = np.zeros(n_children, dtype=np.int64)      # parameters of each child
+        c_counts = np.zeros(n_children, dtype=np.int64)      # connectors of each child
+        slots = []
+        for (_, own, subs), members in by_class.items():
+            group = [items[k] for k in members]
+            at = np.asarray(members, dtype=np.int64)
+            layout = self._layout(group, own, subs, [paths[k] for k in members])
+            if isinstance(layout, str):
+                self.refused = layout
+                return
+            for slot in layout:
+                if slot.kind == "parameter":
+                    p_counts[at] += 1
+                else:
+                    counts[at] += 1 + slot.has_der
+            c_counts[at] = len(subs)
+            slots.append((at, layout, subs))
+        base = np.cumsum(counts) - counts
+        p_base = np.cumsum(p_counts) - p_counts
+        c_base = np.cumsum(c_counts) - c_counts
+        self.n = n = int(counts.sum())
+        n_p = int(p_counts.sum())
+        n_c = int(c_counts.sum())
+        order = np.empty(n, dtype=object)
+        names = np.empty(n, dtype=object)
+        params = np.empty(n_p, dtype=object)
+        param_names = np.empty(n_p, dtype=object)
+        param_owners = np.empty(n_p, dtype=object)
+        conn_paths = np.empty(n_c, dtype=object)
+        kinds: list[tuple[tuple[str, ...], np.ndarray]] = []
+        self.kind_of = np.zeros(n_c, dtype=np.int64)
+        width = max((len(sub[2]) for _, _, subs in slots for sub in subs), default=0)
+        self.columns = np.full((n_c, max(width, 1)), -1, dtype=np.int64)
+        self.connector: dict[int, int] = {}
+        pos = _Positions()
+        for at, layout, subs in slots:
+            col, p_col = base[at].copy(), p_base[at].copy()
+            for j, (sub_name, _, keys) in enumerate(subs):
+                c = c_base[at] + j
+                conn_paths[c] = [f"{paths[k]}.{sub_name}" for k in at.tolist()]
+                self.connector.update(zip(map(id, (items[k]._children[sub_name]
+                                                   for k in at.tolist())),
+                                          c.tolist(), strict=True))
+                flows = np.array([s.kind == "flow" for s in layout if s.sub == j], dtype=bool)
+                for k, (known, known_flows) in enumerate(kinds):
+                    if known == keys and np.array_equal(known_flows, flows):
+                        break
+                else:
+                    k = len(kinds)
+                    kinds.append((keys, flows))
+                self.kind_of[c] = k
+            for slot in layout:
+                if slot.kind == "parameter":
+                    params[p_col] = _objects(slot.symbols)
+                    param_names[p_col] = slot.names
+                    param_owners[p_col] = slot.owners
+                    pos.update(zip(map(id, slot.symbols), (p_col + n).tolist(), strict=True))
+                    p_col += 1
+                    continue
+                order[col] = _objects(slot.symbols)
+                names[col] = slot.names
+                pos.update(zip(map(id, slot.symbols), col.tolist(), strict=True))
+                if slot.sub >= 0:
+                    self.columns[c_base[at] + slot.sub, slot.index] = col
+                if slot.has_der.any():
+                    has = slot.has_der.astype(bool)
+                    ders = [d for d in slot.ders if d is not None]
+                    order[col[has] + 1] = _objects(ders)
+                    names[col[has] + 1] = [f"der({x})" for x in np.asarray(slot.names,
+                                                                           dtype=object)[has]]
+                    pos.update(zip(map(id, ders), (col[has] + 1).tolist(), strict=True))
+                col += 1 + slot.has_der
+        self.pos = pos
+        self.order, self.names = order.tolist(), names.tolist()
+        self.params, self.param_names = params.tolist(), param_names.tolist()
+        self.param_owners = param_owners.tolist()
+        self.paths = conn_paths.tolist()
+        self.kinds = kinds
+
+    @staticmethod
+    def _layout(group: list[Any], own: tuple[str, ...], subs: tuple, paths: list[str]) -> Any:
+        """The declarations of components of one class and shape, in tree order, each with
+        its symbols across the components (or why they go the scalar way)."""
+        out: list[_Slot] = []
+        places: list[tuple] = [(-1, -1, key, group, paths, paths) for key in own]
+        for j, (sub_name, _, keys) in enumerate(subs):
+            conns = [item._children[sub_name] for item in group]
+            sub_paths = [f"{p}.{sub_name}" for p in paths]
+            places += [(j, i, key, conns, sub_paths, paths) for i, key in enumerate(keys)]
+        for sub, index, key, holders, where, owners in places:
+            symbols = [h._symbols[key] for h in holders]
+            decl_types = set(map(type, map(_DECL, symbols)))
+            if len(decl_types) != 1:
+                return f"{key} is declared differently in components of one class"
+            decl_type = decl_types.pop()
+            if decl_type is Parameter:
+                if not all(issubclass(t, _NUMBERS) and t is not bool for t in
+                           set(map(type, (s.decl.value for s in symbols)))):
+                    return f"a parameter {key} is not given as a number"
+                out.append(_Slot(sub, index, key, "parameter", symbols, where, owners))
+                continue
+            if decl_type not in _VARIABLES:
+                return f"{key} is a {decl_type.__name__}"
+            if set(map(_STATE_SELECT, map(_DECL, symbols))) != {StateSelect.DEFAULT}:
+                return "a variable has a state selection"
+            slot = _Slot(sub, index, key, "flow" if decl_type is Flow else "variable", symbols,
+                         where, owners)
+            if any(d is not None and d.der is not None for d in slot.ders):
+                return "a variable has a second derivative"
+            out.append(slot)
+        return out
+
+
+class _Slot:
+    """One declaration of components of one class: its symbols in every component, their
+    dotted names, and which have a time derivative. ``sub``: the connector it belongs to
+    (-1: the component), ``index`` its place among the connector's variables."""
+
+    def __init__(self, sub: int, index: int, key: str, kind: str, symbols: list[Any],
+                 where: list[str], owners: list[str]) -> None:
+        self.sub, self.index, self.kind, self.symbols = sub, index, kind, symbols
+        self.names = [f"{p}.{key}" for p in where]
+        self.owners = owners
+        self.ders = [s.der for s in symbols]
+        self.has_der = np.fromiter(map(is_not, self.ders, repeat(None)), np.int64,
+                                   len(symbols))
+
+
+class _Positions(dict):
+    """``id(symbol)`` -> column."""
+
+    def of(self, sym: Any) -> int:
+        """The column of ``sym`` (KeyError for a symbol of another model)."""
+        return self[id(sym)]
+
+
+def _objects(items: list[Any]) -> np.ndarray:
+    out = np.empty(len(items), dtype=object)
+    out[:] = items
+    return out
+
+
+def _connections(links: list[Connection], cols: _Columns) -> list[Any] | str:
+    """The connection sets' equations as linear rows, or why they go the scalar way."""
+    index = cols.connector
+    n_c = len(cols.paths)
+    try:
+        heads = np.fromiter((index[id(c.b)] for c in links), np.int64, len(links))
+        tails = np.fromiter((index[id(c.a)] for c in links), np.int64, len(links))
+    except KeyError:
+        return "a connection uses a connector that is not part of the model"
+    if (heads == tails).any():
+        return "a connector is connected to itself"
+    nodes, cuts = connection_set_arrays(n_c, 2 * heads, 2 * tails, cols.paths)
+    starts = np.concatenate(([0], cuts)).astype(np.int64)
+    set_of = np.repeat(np.arange(starts.size), np.diff(np.concatenate((starts, [nodes.size]))))
+    kind = cols.kind_of[nodes >> 1]
+    if (kind != kind[starts][set_of]).any():
+        return "a connection set joins connectors of different kinds"
+    out: list[Any] = []
+    for k, (keys, flows) in enumerate(cols.kinds):
+        mine = kind[starts] == k
+        if not mine.any():
+            continue
+        keep = mine[set_of]
+        sizes = np.diff(np.concatenate((starts, [nodes.size])))[mine]
+        sub_cuts = np.cumsum(sizes)[:-1]
+        out.extend(set_rows(nodes[keep], sub_cuts, cols.columns[:, :len(keys)], flows))
+    return list(chain(out))
