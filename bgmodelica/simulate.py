@@ -193,7 +193,9 @@ def _units_by_name(dae: CasadiDAE, flat: Any) -> dict[str, str]:
     made once per model (kept in ``dae.cache``)."""
     seen = dae.cache.get("units by name")
     if seen is None or seen[0] is not flat:
-        units = {v.name: v.decl.unit for v in flat.variables}
+        by_table = getattr(flat.variables, "units", None)      # (a large model's, at once)
+        units = by_table() if by_table is not None else \
+            {v.name: v.decl.unit for v in flat.variables}
         units.update({q.name: q.decl.unit for q in (*flat.parameters, *flat.inputs)})
         seen = dae.cache["units by name"] = (flat, units)
     return seen[1]

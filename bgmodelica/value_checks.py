@@ -97,7 +97,12 @@ def _value_bounds(dae: Any) -> tuple[np.ndarray, np.ndarray]:
 
 def _check_starts(dae: Any, flat: Any) -> None:
     """Fixed start values inside their bounds, all start values finite."""
-    decls = {v.name: v for v in flat.variables} if flat is not None else {}
+    wanted = {dae.names[k] for k, _ in dae.fixed}
+    decls = {}
+    if flat is not None and wanted:
+        lookup = getattr(flat.variables, "lookup", None)     # (a large model's, by index)
+        decls = lookup(wanted) if lookup is not None else \
+            {v.name: v for v in flat.variables if v.name in wanted}
     for k, value in dae.fixed:
         name = dae.names[k]
         v = decls.get(name)

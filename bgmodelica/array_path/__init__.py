@@ -19,7 +19,9 @@ the scalar pipeline on first use (:class:`ArrayCompiledModel`), and their time i
 from __future__ import annotations
 
 import time as _time
-from operator import attrgetter
+from collections.abc import Iterator, Sequence
+from itertools import repeat
+from operator import attrgetter, is_not
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -74,12 +76,10 @@ def _build(model: Any, units: str, minimum: int | None) -> ArrayCompiledModel | 
         return f"{type(err).__name__}: {err}"
     if isinstance(found, str):
         return found
-    kept = range(len(col.order))
-    if found.aliases:
-        kept = [k for k, name in enumerate(col.names) if name not in found.aliases]
-    variables = [col.order[k] for k in kept]
-    names = [col.names[k] for k in kept] if col.scoped else None
-    return ArrayCompiledModel.made(col.name, found, col.n_rows, timings, model, units,
+    dae, kept = found
+    variables = list(map(col.order.__getitem__, kept))
+    names = list(map(col.names.__getitem__, kept)) if col.scoped else None
+    return ArrayCompiledModel.made(col.name, dae, col.n_rows, timings, model, units,
                                    variables, names)
 
 
@@ -97,7 +97,7 @@ def _compile_blocks(col: Any, lap: Any) -> Any:
         kept[:] = False
         kept[aliases.keep] = True
     lap("lowering")
-    is_state = np.fromiter((s.der is not None for s in col.order), bool, n)
+    is_state = np.fromiter(map(is_not, map(_DER, col.order), repeat(None)), bool, n)
     unknown = np.flatnonzero(~is_state & kept)
     n_rows = int(sum(low.sizes))
     if unknown.size != n_rows:
@@ -116,7 +116,7 @@ def _compile_blocks(col: Any, lap: Any) -> Any:
     lap("solve")
     dae = assemble(col, low, solved, np.flatnonzero(is_state), aliases)
     lap("backend")
-    return dae
+    return dae, np.flatnonzero(kept).tolist()
 
 
 class ArrayCompiledModel(CompiledModel):
@@ -201,7 +201,7 @@ class ArrayCompiledModel(CompiledModel):
         }
 
 
-_DECL = attrgetter("decl")
+_DECL, _DER, _UNIT = attrgetter("decl"), attrgetter("der"), attrgetter("unit")
 
 
 class Declared(NamedTuple):
@@ -209,6 +209,36 @@ class Declared(NamedTuple):
 
     name: str
     decl: Any
+
+
+class _Variables(Sequence):
+    """The variables of a model of components as :class:`Declared` items, made as they are
+    read (a list of them would be one more object per variable for the collector to scan)."""
+
+    def __init__(self, names: list[str], symbols: list[Any]) -> None:
+        self.names, self.symbols = names, symbols
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+    def __getitem__(self, k: Any) -> Any:
+        if isinstance(k, slice):
+            return list(map(Declared, self.names[k], map(_DECL, self.symbols[k])))
+        return Declared(self.names[k], self.symbols[k].decl)
+
+    def __iter__(self) -> Iterator[Declared]:
+        return map(Declared, self.names, map(_DECL, self.symbols))
+
+    def units(self) -> dict[str, str]:
+        """Name -> declared unit, without an item per variable."""
+        return dict(zip(self.names, map(_UNIT, map(_DECL, self.symbols)), strict=True))
+
+    def lookup(self, names: set[str]) -> dict[str, Declared]:
+        """The variables of these names (name -> item; names not found are left out)."""
+        index = self.__dict__.get("_index")
+        if index is None:
+            index = self._index = dict(zip(self.names, range(len(self.names)), strict=True))
+        return {name: self[index[name]] for name in names if name in index}
 
 
 class Declarations:
@@ -221,7 +251,7 @@ class Declarations:
         self.variables = compiled.__dict__["_variables"]
         names = compiled.__dict__.get("_names")
         if names is not None:
-            self.variables = list(map(Declared, names, map(_DECL, self.variables)))
+            self.variables = _Variables(names, self.variables)
         self.parameters = compiled.dae.parameters
         self.inputs = compiled.dae.inputs
         self.discretes: list[Any] = []

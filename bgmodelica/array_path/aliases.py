@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from itertools import repeat
-from operator import attrgetter, is_not, methodcaller
+from operator import attrgetter, is_, is_not, methodcaller
 from typing import Any
 
 import numpy as np
@@ -24,7 +24,8 @@ from ..structure.alias import alias_classes
 from .collect import Collected
 from .connections import LinearRows
 
-_DECL, _DER = attrgetter("decl"), attrgetter("der")
+_DECL, _DER, _DER_OF = attrgetter("decl"), attrgetter("der"), attrgetter("der_of")
+_STATE_SELECT, _FIXED = attrgetter("state_select"), attrgetter("fixed")
 
 
 @dataclass
@@ -49,7 +50,7 @@ def find_aliases(col: Collected) -> Aliases | str | None:
     order, pos = col.order, col.pos
     n = len(order)
     plain = np.zeros(n + len(col.params) + 1, dtype=bool)   # variables that may be linked
-    plain[:n] = np.fromiter((s.der_of is None for s in order), bool, n)
+    plain[:n] = np.fromiter(map(is_, map(_DER_OF, order), repeat(None)), bool, n)
     heads: list[np.ndarray] = []
     tails: list[np.ndarray] = []
     factors: list[np.ndarray] = []
@@ -104,14 +105,17 @@ def find_aliases(col: Collected) -> Aliases | str | None:
         return "alias equations close a cycle"
     rep = np.asarray(classes.rep, dtype=np.int64)
     members = np.flatnonzero(rep != np.arange(n)).tolist()
-    if any(order[i].der is not None for i in members):
+    if any(map(is_not, map(_DER, map(order.__getitem__, members)), repeat(None))):
         return "an alias of a differentiated variable"
     starts = _merged_starts(order, classes.rep, classes.sign, members)
     if isinstance(starts, str):
         return starts
     keep = np.ones(n, dtype=bool)
     keep[members] = False
-    names = {names_of[i]: (names_of[classes.rep[i]], classes.sign[i]) for i in members}
+    name_of, sign_of = names_of.__getitem__, classes.sign.__getitem__
+    names = dict(zip(map(name_of, members),
+                     zip(map(name_of, rep[members].tolist()), map(sign_of, members),
+                         strict=True), strict=True))
     return Aliases(np.flatnonzero(keep), rep, np.asarray(classes.sign, dtype=float), dropped,
                    names, starts)
 
@@ -144,15 +148,18 @@ def _ranks(order: list[Any], names: list[str], heads: np.ndarray,
     """:func:`bgmodelica.passes.alias._ranks` on the collected columns: the dense rank of
     (has a derivative, state priority, fixed start, fewer dots, shorter name) among the
     linked variables, 0 for the others."""
-    linked = np.unique(np.concatenate([heads, tails]))
+    mask = np.zeros(len(order), dtype=bool)
+    mask[heads] = True
+    mask[tails] = True
+    linked = np.flatnonzero(mask)
     at = linked.tolist()
-    syms = [order[i] for i in at]
+    syms = list(map(order.__getitem__, at))
     decls = list(map(_DECL, syms))
-    texts = [names[i] for i in at]
+    texts = list(map(names.__getitem__, at))
     keys = np.column_stack((
         np.fromiter(map(is_not, map(_DER, syms), repeat(None)), np.int64, len(at)),
-        np.fromiter((int(getattr(d, "state_select", 0)) for d in decls), np.int64, len(at)),
-        np.fromiter((bool(getattr(d, "fixed", False)) for d in decls), np.int64, len(at)),
+        np.fromiter(map(int, map(_STATE_SELECT, decls)), np.int64, len(at)),
+        np.fromiter(map(bool, map(_FIXED, decls)), np.int64, len(at)),
         -np.fromiter(map(methodcaller("count", "."), texts), np.int64, len(at)),
         -np.fromiter(map(len, texts), np.int64, len(at))))
     keys -= keys.min(axis=0)                 # one integer, ordered as the tuples are

@@ -47,9 +47,10 @@ class Collected:
     as tables). ``names`` and ``param_names`` are their dotted names (``scoped``: the
     symbols' own names are not: a model of components), ``param_owners`` the components
     declaring the parameters (None: the top level); ``sources`` the equations as written
-    with their origins for the unit check (None: all written at ``where``). ``pos`` maps ``id(symbol)`` to its column (variables and
-    derivatives, then parameters, then time) and ``memo`` the declared arrays to their
-    columns (as :func:`~bgmodelica.core.flatten_arrays.residual` reads them)."""
+    with their origins for the unit check (None: all written at ``where``). ``pos`` maps
+    ``id(symbol)`` to its column (variables and derivatives, then parameters, then time) and
+    ``memo`` the declared arrays to their columns (as
+    :func:`~bgmodelica.core.flatten_arrays.residual` reads them)."""
 
     name: str
     where: str

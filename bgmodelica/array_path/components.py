@@ -18,7 +18,7 @@ level, initial equations, events) goes the scalar way.
 from __future__ import annotations
 
 from itertools import chain, repeat
-from operator import attrgetter, is_not
+from operator import add, attrgetter, is_not, itemgetter
 from typing import Any
 
 import numpy as np
@@ -28,7 +28,12 @@ from ..core.component import Component, Connection, Connector, _own_methods
 from ..core.expr import Equation
 from ..core.flatmodel import EquationSources
 from ..core.flatten_connections import connection_set_arrays
-from ..core.flatten_vectorized import GROUP_FROM, array_equations, component_groups
+from ..core.flatten_vectorized import (
+    GROUP_FROM,
+    _same_keys,
+    array_equations,
+    component_groups,
+)
 from ..core.variables import (
     TIME,
     Flow,
@@ -40,7 +45,9 @@ from ..core.variables import (
 )
 from .connections import LinearRows, set_rows
 
-_DECL, _STATE_SELECT = attrgetter("decl"), attrgetter("state_select")
+_DECL, _DER, _STATE_SELECT = attrgetter("decl"), attrgetter("der"), attrgetter("state_select")
+_A, _B = attrgetter("a"), attrgetter("b")
+_VALUE, _SYMBOLS, _CHILDREN = attrgetter("value"), attrgetter("_symbols"), attrgetter("_children")
 _VARIABLES = (Variable, Output, Potential, Flow)
 _NUMBERS = (int, float, np.integer, np.floating)
 #: at most this many scalar equations of components asked one by one
@@ -121,8 +128,7 @@ class _Equations:
         self.arrays: list[tuple[ArrayEquation, str, list[str] | None]] = []
         self.refused: str | None = None
         self.links = guarded_equations(model, where, "", blocks=True)
-        if not all(type(c) is Connection and isinstance(c.a, Connector)
-                   and isinstance(c.b, Connector) for c in self.links):
+        if set(map(type, self.links)) - {Connection} or not _connectors_only(self.links):
             self.refused = "the top level has equations other than connections of connectors"
             return
         done: set[int] = set()
@@ -156,6 +162,12 @@ class _Equations:
                 self.items.append(eq)
 
 
+def _connectors_only(links: list[Connection]) -> bool:
+    """Whether every connection joins two connectors (not signals)."""
+    ends = set(map(type, map(_A, links))) | set(map(type, map(_B, links)))
+    return all(issubclass(t, Connector) for t in ends)
+
+
 def _scalar_groups(scalars: list[tuple[Equation, str]]) -> dict[Any, list]:
     from ..passes.units import _scalar_groups as groups
 
@@ -177,15 +189,21 @@ class _Columns:
         items = list(children.values())
         by_class: dict[Any, list[int]] = {}
         for k, child in enumerate(items):
-            key = (type(child), tuple(child._symbols), tuple(
-                (name, type(sub), tuple(sub._symbols)) for name, sub in child._children.items()))
-            by_class.setdefault(key, []).append(k)
+            by_class.setdefault(type(child), []).append(k)
+        by_layout: dict[Any, list[int]] = {}
+        for cls, members in by_class.items():
+            group = [items[k] for k in members]
+            if _same_keys(group):                 # the usual case: one layout per class
+                by_layout[(cls, *_layout_key(group[0]))] = members
+                continue
+            for k in members:
+                by_layout.setdefault((cls, *_layout_key(items[k])), []).append(k)
         n_children = len(items)
         counts = np.zeros(n_children, dtype=np.int64)        # columns of each child
         p_counts = np.zeros(n_children, dtype=np.int64)      # parameters of each child
         c_counts = np.zeros(n_children, dtype=np.int64)      # connectors of each child
         slots = []
-        for (_, own, subs), members in by_class.items():
+        for (_, own, subs), members in by_layout.items():
             group = [items[k] for k in members]
             at = np.asarray(members, dtype=np.int64)
             layout = self._layout(group, own, subs, [paths[k] for k in members])
@@ -211,7 +229,7 @@ class _Columns:
         param_names = np.empty(n_p, dtype=object)
         param_owners = np.empty(n_p, dtype=object)
         conn_paths = np.empty(n_c, dtype=object)
-        kinds: list[tuple[tuple[str, ...], np.ndarray]] = []
+        kind_ids: dict[tuple[tuple[str, ...], tuple[bool, ...]], int] = {}
         self.kind_of = np.zeros(n_c, dtype=np.int64)
         width = max((len(sub[2]) for _, _, subs in slots for sub in subs), default=0)
         self.columns = np.full((n_c, max(width, 1)), -1, dtype=np.int64)
@@ -219,19 +237,13 @@ class _Columns:
         pos = _Positions()
         for at, layout, subs in slots:
             col, p_col = base[at].copy(), p_base[at].copy()
-            for j, (sub_name, _, keys) in enumerate(subs):
+            for j, (_, _, keys) in enumerate(subs):
                 c = c_base[at] + j
-                conn_paths[c] = [f"{paths[k]}.{sub_name}" for k in at.tolist()]
-                self.connector.update(zip(map(id, (items[k]._children[sub_name]
-                                                   for k in at.tolist())),
-                                          c.tolist(), strict=True))
-                flows = np.array([s.kind == "flow" for s in layout if s.sub == j], dtype=bool)
-                for k, (known, known_flows) in enumerate(kinds):
-                    if known == keys and np.array_equal(known_flows, flows):
-                        break
-                else:
-                    k = len(kinds)
-                    kinds.append((keys, flows))
+                conn_paths[c] = layout.sub_paths[j]
+                self.connector.update(zip(map(id, layout.connectors[j]), c.tolist(),
+                                          strict=True))
+                flows = tuple(s.kind == "flow" for s in layout if s.sub == j)
+                k = kind_ids.setdefault((keys, flows), len(kind_ids))
                 self.kind_of[c] = k
             for slot in layout:
                 if slot.kind == "parameter":
@@ -259,40 +271,63 @@ class _Columns:
         self.params, self.param_names = params.tolist(), param_names.tolist()
         self.param_owners = param_owners.tolist()
         self.paths = conn_paths.tolist()
-        self.kinds = kinds
+        self.kinds = [(keys, np.array(flows, dtype=bool)) for keys, flows in kind_ids]
 
     @staticmethod
     def _layout(group: list[Any], own: tuple[str, ...], subs: tuple, paths: list[str]) -> Any:
         """The declarations of components of one class and shape, in tree order, each with
         its symbols across the components (or why they go the scalar way)."""
-        out: list[_Slot] = []
+        out = _Layout()
         places: list[tuple] = [(-1, -1, key, group, paths, paths) for key in own]
         for j, (sub_name, _, keys) in enumerate(subs):
-            conns = [item._children[sub_name] for item in group]
-            sub_paths = [f"{p}.{sub_name}" for p in paths]
+            conns = list(map(itemgetter(sub_name), map(_CHILDREN, group)))
+            sub_paths = list(map(add, paths, repeat(f".{sub_name}")))
+            out.connectors.append(conns)
+            out.sub_paths.append(sub_paths)
             places += [(j, i, key, conns, sub_paths, paths) for i, key in enumerate(keys)]
+        tables: dict[int, list[dict]] = {}
         for sub, index, key, holders, where, owners in places:
-            symbols = [h._symbols[key] for h in holders]
-            decl_types = set(map(type, map(_DECL, symbols)))
+            table = tables.get(sub)
+            if table is None:
+                table = tables[sub] = list(map(_SYMBOLS, holders))
+            symbols = list(map(itemgetter(key), table))
+            decls = list(map(_DECL, symbols))
+            decl_types = set(map(type, decls))
             if len(decl_types) != 1:
                 return f"{key} is declared differently in components of one class"
             decl_type = decl_types.pop()
             if decl_type is Parameter:
                 if not all(issubclass(t, _NUMBERS) and t is not bool for t in
-                           set(map(type, (s.decl.value for s in symbols)))):
+                           set(map(type, map(_VALUE, decls)))):
                     return f"a parameter {key} is not given as a number"
                 out.append(_Slot(sub, index, key, "parameter", symbols, where, owners))
                 continue
             if decl_type not in _VARIABLES:
                 return f"{key} is a {decl_type.__name__}"
-            if set(map(_STATE_SELECT, map(_DECL, symbols))) != {StateSelect.DEFAULT}:
+            if set(map(_STATE_SELECT, decls)) != {StateSelect.DEFAULT}:
                 return "a variable has a state selection"
             slot = _Slot(sub, index, key, "flow" if decl_type is Flow else "variable", symbols,
                          where, owners)
-            if any(d is not None and d.der is not None for d in slot.ders):
+            if slot.has_der.any() and any(d.der is not None for d in slot.ders if d is not None):
                 return "a variable has a second derivative"
             out.append(slot)
         return out
+
+
+class _Layout(list):
+    """The slots of a class of components (a list of :class:`_Slot`), with the components'
+    connectors and their dotted paths, connector by connector."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.connectors: list[list[Any]] = []
+        self.sub_paths: list[list[str]] = []
+
+
+def _layout_key(child: Any) -> tuple:
+    """A component's declarations and connectors (with theirs)."""
+    return (tuple(child._symbols), tuple((name, type(sub), tuple(sub._symbols))
+                                         for name, sub in child._children.items()))
 
 
 class _Slot:
@@ -303,9 +338,9 @@ class _Slot:
     def __init__(self, sub: int, index: int, key: str, kind: str, symbols: list[Any],
                  where: list[str], owners: list[str]) -> None:
         self.sub, self.index, self.kind, self.symbols = sub, index, kind, symbols
-        self.names = [f"{p}.{key}" for p in where]
+        self.names = list(map(add, where, repeat(f".{key}")))
         self.owners = owners
-        self.ders = [s.der for s in symbols]
+        self.ders = list(map(_DER, symbols))
         self.has_der = np.fromiter(map(is_not, self.ders, repeat(None)), np.int64,
                                    len(symbols))
 

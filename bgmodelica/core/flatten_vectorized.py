@@ -20,7 +20,7 @@ differs between elements, an ``if`` on a variable, an event, a ``connect``) make
 from __future__ import annotations
 
 import inspect
-from operator import attrgetter
+from operator import attrgetter, itemgetter, methodcaller
 from types import FunctionType, MethodType
 from typing import Any
 
@@ -159,24 +159,48 @@ def array_equations(items: list[Any]) -> list[ArrayEquation] | None:
 
 
 def _uniform(items: list[Any]) -> bool:
-    """Leaf components of one class with the same declarations and connectors, no equations
-    or arrays added to an instance."""
+    """Leaf components of one class holding exactly its declarations and connectors (nothing
+    added to an instance, no arrays, no equations), connectors without subconnectors.
+    Checked with C-level maps: a group may be large."""
     first = items[0]
-    cls = type(first)
-    if not isinstance(first, Component):
+    if not isinstance(first, Component) or any(map(_EQUATIONS, items)) \
+            or not _as_declared(items):
         return False
-    symbols = first._symbols.keys()
-    children = first._children
-    if any(not isinstance(c, Connector) or c._children or "_arrays" in c.__dict__
-           for c in children.values()):
-        return False
-    connector_symbols = {k: c._symbols.keys() for k, c in children.items()}
-    for item in items:
-        if type(item) is not cls or item._equations or "_arrays" in item.__dict__ \
-                or item._symbols.keys() != symbols or item._children.keys() != children.keys():
+    for key, c in first._children.items():
+        if not isinstance(c, Connector) or type(c)._templates \
+                or not _as_declared(list(map(itemgetter(key), map(_CHILDREN, items)))):
             return False
-        for k, c in item._children.items():
-            if type(c) is not type(children[k]) or c._children or "_arrays" in c.__dict__ \
-                    or c._symbols.keys() != connector_symbols[k]:
-                return False
     return True
+
+
+_SYMBOLS, _CHILDREN = attrgetter("_symbols"), attrgetter("_children")
+_EQUATIONS, _DICT = attrgetter("_equations"), attrgetter("__dict__")
+
+
+def _any_arrays(elements: list[Any]) -> bool:
+    """Whether an element has arrays declared on it."""
+    return any(map(methodcaller("__contains__", "_arrays"), map(_DICT, elements)))
+
+
+def _same_keys(items: list[Any]) -> bool:
+    """Whether the components (of one class) have the same declarations and connectors, and
+    each connector the same declarations (and class)."""
+    if _as_declared(items):
+        return all(_as_declared(list(map(itemgetter(key), map(_CHILDREN, items))))
+                   for key in items[0]._children)
+    if len(set(map(tuple, map(_SYMBOLS, items)))) != 1 \
+            or len(set(map(tuple, map(_CHILDREN, items)))) != 1:
+        return False
+    return all(len(set(map(tuple, map(_SYMBOLS, map(itemgetter(key), map(_CHILDREN, items))))))
+               == 1 and len(set(map(type, map(itemgetter(key), map(_CHILDREN, items))))) == 1
+               for key in items[0]._children)
+
+
+def _as_declared(elements: list[Any]) -> bool:
+    """Whether the elements are of one class and hold exactly its declarations and
+    subcomponents, in its order: nothing was added to an instance (which only adds, so
+    equal counts say it), no arrays (whose elements are counted one by one)."""
+    cls = type(elements[0])
+    return set(map(type, elements)) == {cls} and not _any_arrays(elements) \
+        and set(map(len, map(_SYMBOLS, elements))) == {len(cls._declarations)} \
+        and set(map(len, map(_CHILDREN, elements))) == {len(cls._templates)}

@@ -8,10 +8,11 @@ array equation), solves explicitly block by block when
 - the blocks depend on each other without a cycle.
 
 A block is solved as whole-vector operations: ``i[2:n] = (v[1:n-1] - v[2:n]) / R[2:n]`` is
-one. Where equations of a block use unknowns solved by others of the same block (a sum of
-currents using the currents of the other nodes, a short recurrence), the block is split into
-*levels*: the equations using none of their block's unknowns first, then those using only
-these, and so on, at most :data:`MAX_LEVELS` of them (a longer recurrence is refused).
+one. Equations are taken by *level*: those using no unknown first, then those using only
+these, and so on; a block whose equations sit at several levels (a sum of currents using the
+currents of the other nodes, a class of component used in two roles) is solved in parts,
+level by level. A system deeper than :data:`MAX_LEVELS` levels is ordered block by block
+instead, with levels inside each block only (a recurrence deeper than that is refused).
 
 A system with only 1x1 blocks has a single perfect matching, so the answer does not depend on
 the matching found. The work is done on sparse integer arrays (scipy's compiled matching and
@@ -24,7 +25,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-
 
 #: a block is split into at most this many levels (each is one vector operation)
 MAX_LEVELS = 64
@@ -75,30 +75,40 @@ def explicit_order(n: int, rows: np.ndarray, cols: np.ndarray,
     if n_scc != n:
         return f"{n - n_scc} more unknowns than 1x1 blocks: an algebraic loop"
     block_of = np.repeat(np.arange(len(block_sizes)), block_sizes)
-    inner = (block_of[rows] == block_of[source]) & (rows != source)
-    level = _levels(n, rows[inner], source[inner])
-    if level is None:
-        return (f"an equation uses an unknown solved by another row of its own block, over "
-                f"more than {MAX_LEVELS} levels (a recurrence)")
-    n_levels = int(level.max()) + 1
-    step_of = block_of * n_levels + level
-    steps, step_of = np.unique(step_of, return_inverse=True)      # (block, level) in order
-    b_row, b_src = step_of[rows], step_of[source]
-    cross = b_row != b_src
-    n_steps = steps.size
-    edges = np.unique(b_src[cross] * n_steps + b_row[cross])
-    order = _topological(n_steps, edges // n_steps, edges % n_steps)
-    if order is None:
-        return "the blocks depend on each other in a cycle"
-    blocks = (steps // n_levels)[order].tolist()
-    if n_levels == 1:
+    n_blocks = len(block_sizes)
+    uses = rows != source
+    level = _levels(n, rows[uses], source[uses])
+    if level is not None:
+        # levels of the whole system: a row comes after every row it uses, so steps taken
+        # by level (then block, as written) are in order
+        step_of = level * n_blocks + block_of
+        steps, step_of = np.unique(step_of, return_inverse=True)
+        order = list(range(steps.size))
+        step_block = steps % n_blocks
+    else:
+        # a deep system: levels inside each block only, blocks ordered by their dependences
+        inner = uses & (block_of[rows] == block_of[source])
+        level = _levels(n, rows[inner], source[inner])
+        if level is None:
+            return (f"an equation uses an unknown solved by another row of its own block, "
+                    f"over more than {MAX_LEVELS} levels (a recurrence)")
+        n_levels = int(level.max()) + 1
+        steps, step_of = np.unique(block_of * n_levels + level, return_inverse=True)
+        b_row, b_src = step_of[rows], step_of[source]
+        cross = b_row != b_src
+        edges = np.unique(b_src[cross] * steps.size + b_row[cross])
+        found = _topological(steps.size, edges // steps.size, edges % steps.size)
+        if found is None:
+            return "the blocks depend on each other in a cycle"
+        order = found
+        step_block = steps // n_levels
+    blocks = step_block[order].tolist()
+    split = np.bincount(step_block, minlength=n_blocks) > 1
+    if not split.any():
         return ExplicitOrder(unknown_of.astype(np.int64), blocks)
     starts = np.concatenate(([0], np.cumsum(block_sizes)))
-    split = np.bincount(steps // n_levels, minlength=len(block_sizes)) > 1
-    parts = []
-    for step, b in zip(order, blocks, strict=True):
-        parts.append(np.flatnonzero(step_of[starts[b]:starts[b + 1]] == step)
-                     if split[b] else None)
+    parts = [np.flatnonzero(step_of[starts[b]:starts[b + 1]] == step) if split[b] else None
+             for step, b in zip(order, blocks, strict=True)]
     return ExplicitOrder(unknown_of.astype(np.int64), blocks, parts)
 
 
