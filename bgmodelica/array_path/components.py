@@ -81,8 +81,9 @@ def collect_components(model: Component, minimum: int) -> Any:
         return "small"
     pos = cols.pos
     pos[id(TIME)] = cols.n + len(cols.params)
+    memo = _memo(equations.groups, cols, children)
     sources = EquationSources(groups=_scalar_groups(equations.scalars), arrays=equations.arrays)
-    return Collected(name, where, cols.order, cols.params, all_equations, n_rows, pos, {},
+    return Collected(name, where, cols.order, cols.params, all_equations, n_rows, pos, memo,
                      0, cols.names, cols.param_names, cols.param_owners, sources, True)
 
 
@@ -127,6 +128,7 @@ class _Equations:
         self.scalars: list[tuple[Equation, str]] = []
         self.arrays: list[tuple[ArrayEquation, str, list[str] | None]] = []
         self.refused: str | None = None
+        self.groups: list[tuple[list[Any], dict]] = []     # (components, arrays they read)
         self.links = guarded_equations(model, where, "", blocks=True)
         if set(map(type, self.links)) - {Connection} or not _connectors_only(self.links):
             self.refused = "the top level has equations other than connections of connectors"
@@ -134,9 +136,11 @@ class _Equations:
         done: set[int] = set()
         if len(children) >= GROUP_FROM or "_arrays" in model.__dict__:
             for names, items in component_groups(model):
-                eqs = array_equations(items)
+                arrays: dict[tuple[str | None, str], Any] = {}
+                eqs = array_equations(items, arrays)
                 if eqs is None:
                     continue
+                self.groups.append((items, arrays))
                 cls = type(items[0]).__name__
                 origin = f"{names[0]} .. {names[-1]} ({len(items)} {cls} components)"
                 wheres = [f"{name} ({cls})" for name in names]
@@ -199,6 +203,9 @@ class _Columns:
             for k in members:
                 by_layout.setdefault((cls, *_layout_key(items[k])), []).append(k)
         n_children = len(items)
+        self.layouts: list[_Layout] = []
+        self.group_of = np.zeros(n_children, dtype=np.int64)    # each child's layout
+        self.place_of = np.zeros(n_children, dtype=np.int64)    # and its place in it
         counts = np.zeros(n_children, dtype=np.int64)        # columns of each child
         p_counts = np.zeros(n_children, dtype=np.int64)      # parameters of each child
         c_counts = np.zeros(n_children, dtype=np.int64)      # connectors of each child
@@ -217,6 +224,9 @@ class _Columns:
                     counts[at] += 1 + slot.has_der
             c_counts[at] = len(subs)
             slots.append((at, layout, subs))
+            self.group_of[at] = len(self.layouts)
+            self.place_of[at] = np.arange(at.size)
+            self.layouts.append(layout)
         base = np.cumsum(counts) - counts
         p_base = np.cumsum(p_counts) - p_counts
         c_base = np.cumsum(c_counts) - c_counts
@@ -250,12 +260,14 @@ class _Columns:
                     params[p_col] = _objects(slot.symbols)
                     param_names[p_col] = slot.names
                     param_owners[p_col] = slot.owners
-                    pos.update(zip(map(id, slot.symbols), (p_col + n).tolist(), strict=True))
+                    slot.columns = p_col + n
+                    pos.add(slot.symbols, slot.columns, at.size < GROUP_FROM)
                     p_col += 1
                     continue
                 order[col] = _objects(slot.symbols)
                 names[col] = slot.names
-                pos.update(zip(map(id, slot.symbols), col.tolist(), strict=True))
+                slot.columns = col.copy()
+                pos.add(slot.symbols, slot.columns, at.size < GROUP_FROM)
                 if slot.sub >= 0:
                     self.columns[c_base[at] + slot.sub, slot.index] = col
                 if slot.has_der.any():
@@ -279,6 +291,7 @@ class _Columns:
         its symbols across the components (or why they go the scalar way)."""
         out = _Layout()
         places: list[tuple] = [(-1, -1, key, group, paths, paths) for key in own]
+        sub_names = [sub_name for sub_name, _, _ in subs]
         for j, (sub_name, _, keys) in enumerate(subs):
             conns = list(map(itemgetter(sub_name), map(_CHILDREN, group)))
             sub_paths = list(map(add, paths, repeat(f".{sub_name}")))
@@ -300,7 +313,8 @@ class _Columns:
                 if not all(issubclass(t, _NUMBERS) and t is not bool for t in
                            set(map(type, map(_VALUE, decls)))):
                     return f"a parameter {key} is not given as a number"
-                out.append(_Slot(sub, index, key, "parameter", symbols, where, owners))
+                out.add(_Slot(sub, index, key, "parameter", symbols, where, owners),
+                        None if sub < 0 else sub_names[sub])
                 continue
             if decl_type not in _VARIABLES:
                 return f"{key} is a {decl_type.__name__}"
@@ -310,7 +324,7 @@ class _Columns:
                          where, owners)
             if slot.has_der.any() and any(d.der is not None for d in slot.ders if d is not None):
                 return "a variable has a second derivative"
-            out.append(slot)
+            out.add(slot, None if sub < 0 else sub_names[sub])
         return out
 
 
@@ -322,6 +336,11 @@ class _Layout(list):
         super().__init__()
         self.connectors: list[list[Any]] = []
         self.sub_paths: list[list[str]] = []
+        self.by_key: dict[tuple[str | None, str], _Slot] = {}
+
+    def add(self, slot: _Slot, sub_name: str | None) -> None:
+        self.append(slot)
+        self.by_key[(sub_name, slot.key)] = slot
 
 
 def _layout_key(child: Any) -> tuple:
@@ -338,6 +357,8 @@ class _Slot:
     def __init__(self, sub: int, index: int, key: str, kind: str, symbols: list[Any],
                  where: list[str], owners: list[str]) -> None:
         self.sub, self.index, self.kind, self.symbols = sub, index, kind, symbols
+        self.key = key
+        self.columns: np.ndarray = np.zeros(0, dtype=np.int64)     # set by _Columns
         self.names = list(map(add, where, repeat(f".{key}")))
         self.owners = owners
         self.ders = list(map(_DER, symbols))
@@ -346,11 +367,54 @@ class _Slot:
 
 
 class _Positions(dict):
-    """``id(symbol)`` -> column."""
+    """``id(symbol)`` -> column. Most symbols are entered on the first lookup that misses:
+    the arrays that groups of components read are found in the lowering's memo instead
+    (:func:`_memo`)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.pending: list[tuple[list[Any], np.ndarray]] = []
+
+    def add(self, symbols: list[Any], columns: np.ndarray, now: bool) -> None:
+        """Enter the symbols' columns now, or on the first miss."""
+        if now:
+            self.update(zip(map(id, symbols), columns.tolist(), strict=True))
+        else:
+            self.pending.append((symbols, columns))
+
+    def __missing__(self, key: int) -> int:
+        if not self.pending:
+            raise KeyError(key)
+        for symbols, columns in self.pending:
+            self.update(zip(map(id, symbols), columns.tolist(), strict=True))
+        self.pending = []
+        return self[key]
 
     def of(self, sym: Any) -> int:
         """The column of ``sym`` (KeyError for a symbol of another model)."""
         return self[id(sym)]
+
+
+def _memo(groups: list[tuple[list[Any], dict]], cols: _Columns,
+          children: dict[str, Any]) -> dict[int, Any]:
+    """The columns of the arrays that the groups of components written once read (as
+    :func:`~bgmodelica.core.flatten_arrays._rows` finds them by their base array)."""
+    memo: dict[int, Any] = {}
+    if not groups:
+        return memo
+    index = dict(zip(map(id, children.values()), range(len(children)), strict=True))
+    for items, arrays in groups:
+        at = np.fromiter(map(index.__getitem__, map(id, items)), np.int64, len(items))
+        group = cols.group_of[at]
+        if (group != group[0]).any():
+            continue
+        layout, place = cols.layouts[int(group[0])], cols.place_of[at]
+        for name, arr in arrays.items():
+            slot = layout.by_key.get(name)
+            base = arr.items
+            if slot is not None and base.base is None and base.shape == (len(items),):
+                memo[id(base)] = (base, slot.columns[place])
+    return memo
 
 
 def _objects(items: list[Any]) -> np.ndarray:

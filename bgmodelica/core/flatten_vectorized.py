@@ -136,9 +136,13 @@ def component_groups(elem: Component) -> list[tuple[list[str], list[Any]]]:
     return out
 
 
-def array_equations(items: list[Any]) -> list[ArrayEquation] | None:
+def array_equations(items: list[Any],
+                    arrays: dict[tuple[str | None, str], ArrayExpr] | None = None,
+                    ) -> list[ArrayEquation] | None:
     """The equations of the components ``items`` as array equations (one per equation of
-    their class, over all of them), or None when they cannot be written that way."""
+    their class, over all of them), or None when they cannot be written that way.
+    ``arrays``, if given, receives the arrays of the elements' scalars the equations read,
+    by ``(connector name or None, declaration name)``."""
     if len(items) < 2 or not _uniform(items):
         return None
     view = _View(items)
@@ -155,6 +159,13 @@ def array_equations(items: list[Any]) -> list[ArrayEquation] | None:
                 out.append(eq)
     except Exception:  # noqa: BLE001 -- anything the view cannot answer: one by one instead
         return None
+    if arrays is not None:
+        for name, seen in view._seen.items():
+            if isinstance(seen, ArrayExpr):
+                arrays[(None, name)] = seen
+            else:
+                arrays.update(((name, key), found) for key, found in seen._seen.items()
+                              if isinstance(found, ArrayExpr))
     return out
 
 
