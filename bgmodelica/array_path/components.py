@@ -68,7 +68,7 @@ def collect_components(model: Component, minimum: int) -> Any:
     equations = _Equations(model, children, where)
     if equations.refused is not None:
         return equations.refused
-    cols = _Columns(children)
+    cols = _Columns(children, [items for items, _ in equations.groups])
     if cols.refused is not None:
         return cols.refused
     rows = _connections(equations.links, cols)
@@ -187,7 +187,9 @@ class _Columns:
     (``connector``: ``id`` -> number, ``paths``, ``kinds``: their variables' names and
     whether each is a flow, ``columns``: their variables' columns)."""
 
-    def __init__(self, children: dict[str, Any]) -> None:
+    def __init__(self, children: dict[str, Any], checked: list[list[Any]]) -> None:
+        """``checked``: groups of components known to share their declarations (written
+        once)."""
         self.refused: str | None = None
         paths = list(children)
         items = list(children.values())
@@ -197,7 +199,7 @@ class _Columns:
         by_layout: dict[Any, list[int]] = {}
         for cls, members in by_class.items():
             group = [items[k] for k in members]
-            if _same_keys(group):                 # the usual case: one layout per class
+            if any(map(group.__eq__, checked)) or _same_keys(group):   # one layout per class
                 by_layout[(cls, *_layout_key(group[0]))] = members
                 continue
             for k in members:

@@ -70,7 +70,7 @@ class _View:
             if isinstance(owner, _PLAIN):
                 return owner                        # a class constant
         try:
-            values = [item.__dict__[name] for item in items]
+            values = list(map(itemgetter(name), map(_DICT, items)))
         except KeyError:
             raise _Varies(name) from None
         first = values[0]
@@ -80,8 +80,8 @@ class _View:
             arr = np.empty(len(values), dtype=object)
             arr[:] = values
             decls = list(map(_DECL, map(_SYM, values)))
-            mark_leaves(arr, len(set(zip(map(type, decls), map(_UNIT, decls),
-                                         strict=True))) == 1)
+            mark_leaves(arr, len(set(map(type, decls))) == 1
+                        and len(set(map(_UNIT, decls))) == 1)
             found = self._seen[name] = ArrayExpr(arr)
             return found
         if isinstance(first, Connector):
