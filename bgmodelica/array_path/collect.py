@@ -6,7 +6,7 @@ is the one the scalar pipeline gives; anything else goes the usual way:
 
 - one component, without subcomponents, connectors, connections or initial equations;
 - plain :class:`~bgmodelica.core.variables.Variable` and
-  :class:`~bgmodelica.core.variables.Output` (default state selection),
+  :class:`~bgmodelica.core.variables.Output` (state selection at most ``PREFER`` or ``AVOID``),
   :class:`~bgmodelica.core.variables.Parameter` and
   :class:`~bgmodelica.core.variables.Input` declarations, parameters given as numbers;
 - equations that are array equations lowered as blocks, or a few scalar equations, built
@@ -31,6 +31,10 @@ from ..core.component import Component, _own_methods
 from ..core.expr import Equation
 from ..core.variables import TIME, Input, Output, Parameter, StateSelect, Symbol, Variable
 
+#: state selections the array path takes: they only rank aliases and the choice of dummy
+#: derivatives, which a model solved explicitly (index 1, no state choice) does not make;
+#: ``ALWAYS`` and ``NEVER`` can contradict the structure, which the scalar pipeline reports
+SOFT_STATE_SELECT = frozenset((StateSelect.DEFAULT, StateSelect.PREFER, StateSelect.AVOID))
 #: the array path is used from this many scalar equations on
 ARRAY_PATH_FROM = 1000
 #: at most this many scalar (non-array) equations: each is lowered on its own
@@ -102,7 +106,7 @@ def collect(model: Any, minimum: int | None = None) -> Collected | str:
                                         zip(runs, kinds, strict=True) if kind in wanted))
 
     variables, params, inputs = of_kind(Variable, Output), of_kind(Parameter), of_kind(Input)
-    if set(map(attrgetter("state_select"), map(_DECL, variables))) - {StateSelect.DEFAULT}:
+    if set(map(attrgetter("state_select"), map(_DECL, variables))) - SOFT_STATE_SELECT:
         return "a variable has a state selection"
     if not all(issubclass(t, _NUMBERS) and t is not bool
                for t in set(map(type, map(attrgetter("value"), map(_DECL, params))))

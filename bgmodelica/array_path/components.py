@@ -40,9 +40,9 @@ from ..core.variables import (
     Output,
     Parameter,
     Potential,
-    StateSelect,
     Variable,
 )
+from .collect import SOFT_STATE_SELECT, Collected
 from .connections import LinearRows, set_rows
 
 _DECL, _DER, _STATE_SELECT = attrgetter("decl"), attrgetter("der"), attrgetter("state_select")
@@ -57,8 +57,6 @@ MAX_SCALAR_EQUATIONS = 256
 def collect_components(model: Component, minimum: int) -> Any:
     """The :class:`~.collect.Collected` of a model of leaf components, or why it goes the
     scalar way."""
-    from .collect import Collected
-
     children = model._children
     found = _shape_check(model, children, minimum)
     if found is not None:
@@ -320,7 +318,7 @@ class _Columns:
                 continue
             if decl_type not in _VARIABLES:
                 return f"{key} is a {decl_type.__name__}"
-            if set(map(_STATE_SELECT, decls)) != {StateSelect.DEFAULT}:
+            if set(map(_STATE_SELECT, decls)) - SOFT_STATE_SELECT:
                 return "a variable has a state selection"
             slot = _Slot(sub, index, key, "flow" if decl_type is Flow else "variable", symbols,
                          where, owners)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import bgmodelica as bg
-from bgmodelica import Component, Parameter, Variable, der
+from bgmodelica import Component, Parameter, StateSelect, Variable, der
 from bgmodelica.array_path import ArrayCompiledModel, compile_arrays, why_not
 from bgmodelica.compiler import _compile
 from bgmodelica.errors import UnbalancedModelError, UnitError
@@ -169,6 +169,28 @@ class LibraryMassChain(Component):
             node = mass.flange_b
 
 
+class AlwaysMass(SlidingMass):
+    """:class:`SlidingMass` whose velocity must be a state (``StateSelect.ALWAYS``, which
+    the scalar pipeline checks against the structure)."""
+
+    v = Variable(unit="m/s", state_select=StateSelect.ALWAYS)
+
+
+class AlwaysMassChain(Component):
+    """Springs and :class:`AlwaysMass` masses from a wall."""
+
+    def __init__(self, n: int = 3, **modifiers):
+        super().__init__(**modifiers)
+        self.wall = tr.Fixed()
+        node = self.wall.flange
+        for k in range(1, n + 1):
+            spring = self.add(f"spring{k}", tr.Spring(c=10.0 * k))
+            mass = self.add(f"mass{k}", AlwaysMass(m=1.0, s=0.1 * k, v=0.0))
+            self.connect(node, spring.flange_a)
+            self.connect(spring.flange_b, mass.flange_a)
+            node = mass.flange_b
+
+
 class ProbedLadder(RCLadder):
     """:class:`RCLadder` with a resistor ``probe`` hanging from node 1, its pin ``n``
     connected to nothing (so ``probe.n.i = 0``, hence ``probe.i = 0``)."""
@@ -242,6 +264,14 @@ def test_a_mechanical_chain_gives_the_scalar_pipelines_dae(n):
     # the last mass's flange_b and the force's flange form a set of two
     assert values[f"mass{n}.flange_b.f"] == values["pull.f_constant"] != 0.0
     assert values["wall.flange.s"] == values["spring1.flange_a.s"] == values["wall.s0"]
+
+
+@pytest.mark.parametrize("n", [2, 70])
+def test_masses_that_prefer_their_states_give_the_scalar_pipelines_dae(n):
+    # library Mass: s and v declared StateSelect.PREFER, which ranks aliases only here
+    fast, slow = _fast_and_slow(lambda: LibraryMassChain(n))
+    _same_dae(fast.dae, slow.dae)
+    assert {f"mass{n}.s", f"mass{n}.v"} <= set(fast.dae.state_names)
 
 
 def test_an_unconnected_connector_carries_no_flow():
@@ -416,7 +446,7 @@ class SignalDriven(Component):
     (lambda: OwnVariables(3), "it has variables beside subcomponents"),
     (WithInitialEquations, "a subcomponent has initial equations"),
     (SignalDriven, "the top level has equations other than connections of connectors"),
-    (lambda: LibraryMassChain(3), "a variable has a state selection"),
+    (lambda: AlwaysMassChain(3), "a variable has a state selection"),
 ], ids=["nested", "own-variables", "initial-equations", "signal-connection",
         "state-selection"])
 def test_models_going_the_scalar_way_say_why_and_compile(make, reason):
