@@ -98,9 +98,10 @@ def find_aliases(col: Collected) -> Aliases | str | None:
             dropped.add(k)
         elif ok.any():
             return "an array equation is partly of aliases"
-    links = list(zip(links_a.tolist(), links_b.tolist(), signs_.tolist(), strict=True))
     names_of = col.names
-    classes = alias_classes(n, links, _ranks(order, names_of, links_a, links_b))
+    ranks = _ranks(order, names_of, links_a, links_b)
+    links = zip(links_a.tolist(), links_b.tolist(), signs_.tolist(), strict=True)
+    classes = alias_classes(n, links, ranks)
     if classes.redundant:
         return "alias equations close a cycle"
     rep = np.asarray(classes.rep, dtype=np.int64)
