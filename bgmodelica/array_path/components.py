@@ -97,13 +97,15 @@ def _shape_check(model: Component, children: dict[str, Any], minimum: int) -> st
     if _own_methods(type(model), "initial_equations") != initial \
             or model.__dict__.get("_initial_equations"):
         return "it has initial equations"
-    size = 0
     for cls in set(map(type, children.values())):
-        if not issubclass(cls, Component) or cls is Component:
+        if not issubclass(cls, Component):
             return "it has connectors of its own"
+        if cls is Component:
+            return "a subcomponent is a plain Component"
         if _own_methods(cls, "initial_equations") != initial:
             return "a subcomponent has initial equations"
-    for child in children.values():
+    size = 0
+    for child in children.values():            # one pass: each element read once
         if child.__dict__.get("_initial_equations"):
             return "a subcomponent has initial equations"
         size += len(child._symbols)
@@ -428,8 +430,10 @@ def _connections(links: list[Connection], cols: _Columns) -> list[Any] | str:
     index = cols.connector
     n_c = len(cols.paths)
     try:
-        heads = np.fromiter((index[id(c.b)] for c in links), np.int64, len(links))
-        tails = np.fromiter((index[id(c.a)] for c in links), np.int64, len(links))
+        heads = np.fromiter(map(index.__getitem__, map(id, map(_B, links))), np.int64,
+                            len(links))
+        tails = np.fromiter(map(index.__getitem__, map(id, map(_A, links))), np.int64,
+                            len(links))
     except KeyError:
         return "a connection uses a connector that is not part of the model"
     if (heads == tails).any():
