@@ -167,6 +167,10 @@ def vector_ladder_rows(sizes: list[int], hand: dict[int, float]) -> list[dict]:
     return rows
 
 
+#: the component ladder compiled with ``array_path=False`` (what the cache saves there)
+SCALAR_FORM = "component per section, scalar pipeline"
+
+
 def cache_rows(cases: list[tuple[str, int]]) -> list[dict]:
     """Compile, then compile again from the disk cache (a fresh temporary folder); if that
     load cost more than compiling (the entry is then dropped), a third compile shows what
@@ -176,14 +180,16 @@ def cache_rows(cases: list[tuple[str, int]]) -> list[dict]:
     from bgmodelica import compile
     from library.examples import RCLadderVector
 
-    make = {"component per section": rc_ladder, "array equations": RCLadderVector}
+    make = {"component per section": rc_ladder, "array equations": RCLadderVector,
+            SCALAR_FORM: rc_ladder}
     rows = []
     with tempfile.TemporaryDirectory(prefix="bgm_cache_") as folder:
         for form, n in cases:
             model = make[form](n)                   # constructed outside the timings
+            how = {"cache": folder, "array_path": form != SCALAR_FORM}
             gc.collect()                            # not the garbage of the runs before
             t0 = time.perf_counter()
-            first = compile(model, cache=folder)     # key + compile (+ store, taken out)
+            first = compile(model, **how)            # key + compile (+ store, taken out)
             if "cache_store" not in first.timings:   # the array path: nothing cached
                 build = time.perf_counter() - t0
                 rows.append({"form": form, "n": n, "compile": build, "array_path": True})
@@ -193,7 +199,7 @@ def cache_rows(cases: list[tuple[str, int]]) -> list[dict]:
             build = time.perf_counter() - t0 - first.timings["cache_store"]
             model = make[form](n)
             t0 = time.perf_counter()
-            again = compile(model, cache=folder)
+            again = compile(model, **how)
             load = time.perf_counter() - t0
             row = {"form": form, "n": n, "compile": build, "cached_compile": load,
                    "hit": "cache_load" in again.timings,
@@ -201,7 +207,7 @@ def cache_rows(cases: list[tuple[str, int]]) -> list[dict]:
             if row["dropped"]:
                 model = make[form](n)
                 t0 = time.perf_counter()
-                third = compile(model, cache=folder)
+                third = compile(model, **how)
                 row["third_compile"] = time.perf_counter() - t0
                 row["key_seconds"] = third.timings["cache_skipped"]
             rows.append(row)
@@ -302,18 +308,21 @@ def fmu_cs_vs_native(repeat: int) -> dict:
             "reused_vs_one_shot_max_diff": agree}
 
 
-def compile_rows(sizes: list[int]) -> dict:
+def compile_rows(sizes: list[int], array_path: bool = True) -> dict:
     """Compile-scaling rows measured in a fresh interpreter: after the 10^5-section runs
     above this process holds gigabytes of freed, fragmented memory, which slows compiling
-    by about 8 %, and a model is usually compiled in a new session."""
-    out = subprocess.run([sys.executable, str(HERE / "compile_scaling.py"), "--json",
+    by about 8 %, and a model is usually compiled in a new session. ``array_path=False``:
+    through the scalar pipeline."""
+    flag = "--json" if array_path else "--json-scalar"
+    out = subprocess.run([sys.executable, str(HERE / "compile_scaling.py"), flag,
                           str(COMPILE_REPEAT), *map(str, sizes)],
                          capture_output=True, text=True, cwd=HERE.parent)
     if out.returncode:
         raise RuntimeError(f"compile_scaling.py --json failed:\n{out.stderr[-3000:]}")
     rows = json.loads(out.stdout.strip().splitlines()[-1])
     for r in rows:
-        print(f"  compile: {r['equations']} equations in {r['seconds']:.3f} s "
+        print(f"  compile{'' if array_path else ' (scalar pipeline)'}: {r['equations']} "
+              f"equations in {r['seconds']:.3f} s "
               f"({r['us_per_equation']:.1f} us/eq)", flush=True)
     k = float(np.polyfit(np.log([r["equations"] for r in rows]),
                          np.log([r["seconds"] for r in rows]), 1)[0]) if len(rows) > 1 else None
@@ -376,12 +385,18 @@ def table(report: dict) -> str:
                      f"{r['casadi_cvodes_total']:.3f} s | {r['ratio_vs_casadi']:.2f}x | "
                      f"{'<= 2.5x' if r['n'] == 10000 else ('< 0.5 s' if r['n'] == 1000 else '')}"
                      " |")
-    comp = report["compile"]
-    for r in comp["rows"]:
-        lines.append(f"| compile, {r['equations']:,} equations | {r['seconds']:.3f} s | | "
-                     f"{r['us_per_equation']:.1f} us/eq | <= 20 us/eq at 1e5 |")
-    if comp["growth_exponent"] is not None:
-        lines.append(f"| compile growth exponent | {comp['growth_exponent']:.2f} | | | <= 1.1 |")
+    for key, how in (("compile", "RC ladder, component per section"),
+                     ("compile_scalar", "the same, through the scalar pipeline")):
+        comp = report.get(key)
+        if comp is None:
+            continue
+        for r in comp["rows"]:
+            lines.append(f"| compile ({how}), {r['equations']:,} equations | "
+                         f"{r['seconds']:.3f} s | | {r['us_per_equation']:.1f} us/eq | "
+                         "<= 20 us/eq at 1e5 |")
+        if comp["growth_exponent"] is not None:
+            lines.append(f"| compile growth exponent ({how}) | "
+                         f"{comp['growth_exponent']:.2f} | | | <= 1.1 |")
     rb = report["robot"]
     lines.append(f"| robot 10 s, `simulate` (default: `solver=\"auto\"` picks CVODES) | "
                  f"{rb['dynamic'] * 1e3:.1f} ms | CasADi/CVODES by hand "
@@ -484,14 +499,17 @@ def main() -> int:
     vec_sizes = [100, 1000, 10000, 100000] if args.full else [1000, 10000]
     report["rc_ladder_vector"] = vector_ladder_rows(vec_sizes, hand)
     print("disk cache", flush=True)
-    report["cache"] = cache_rows([("component per section", 1000), ("array equations", 10000)]
-                                 + ([("component per section", 10000)] if args.full else []))
+    report["cache"] = cache_rows([("component per section", 1000), ("array equations", 10000),
+                                  (SCALAR_FORM, 1000)]
+                                 + ([("component per section", 10000), (SCALAR_FORM, 10000)]
+                                    if args.full else []))
     print("JIT", flush=True)
     report["jit"] = jit_rows(args.repeat)
     print("robot CS FMU", flush=True)
     report["fmu_cs"] = fmu_cs_vs_native(max(args.repeat, FMU_REPEAT))
     print("compile scaling", flush=True)
     report["compile"] = compile_rows(cells)
+    report["compile_scalar"] = compile_rows(cells, array_path=False)
     print("robot", flush=True)
     report["robot"] = robot(max(args.repeat, FMU_REPEAT))     # runs of milliseconds
     print("co-simulation master", flush=True)
