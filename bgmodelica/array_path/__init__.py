@@ -97,7 +97,8 @@ def _compile_blocks(col: Any, lap: Any) -> Any:
         kept[:] = False
         kept[aliases.keep] = True
     lap("lowering")
-    is_state = np.fromiter(map(is_not, map(_DER, col.order), repeat(None)), bool, n)
+    is_state = col.traits.has_der.astype(bool) if col.traits is not None else \
+        np.fromiter(map(is_not, map(_DER, col.order), repeat(None)), bool, n)
     unknown = np.flatnonzero(~is_state & kept)
     n_rows = int(sum(low.sizes))
     if unknown.size != n_rows:

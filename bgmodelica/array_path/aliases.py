@@ -50,7 +50,8 @@ def find_aliases(col: Collected) -> Aliases | str | None:
     order, pos = col.order, col.pos
     n = len(order)
     plain = np.zeros(n + len(col.params) + 1, dtype=bool)   # variables that may be linked
-    plain[:n] = np.fromiter(map(is_, map(_DER_OF, order), repeat(None)), bool, n)
+    plain[:n] = ~col.traits.is_der if col.traits is not None else \
+        np.fromiter(map(is_, map(_DER_OF, order), repeat(None)), bool, n)
     heads: list[np.ndarray] = []
     tails: list[np.ndarray] = []
     factors: list[np.ndarray] = []
@@ -99,16 +100,17 @@ def find_aliases(col: Collected) -> Aliases | str | None:
         elif ok.any():
             return "an array equation is partly of aliases"
     names_of = col.names
-    ranks = _ranks(order, names_of, links_a, links_b)
+    ranks = _ranks(col, links_a, links_b)
     links = zip(links_a.tolist(), links_b.tolist(), signs_.tolist(), strict=True)
     classes = alias_classes(n, links, ranks)
     if classes.redundant:
         return "alias equations close a cycle"
     rep = np.asarray(classes.rep, dtype=np.int64)
     members = np.flatnonzero(rep != np.arange(n)).tolist()
-    if any(map(is_not, map(_DER, map(order.__getitem__, members)), repeat(None))):
+    if col.traits is not None and col.traits.has_der[members].any() or col.traits is None \
+            and any(map(is_not, map(_DER, map(order.__getitem__, members)), repeat(None))):
         return "an alias of a differentiated variable"
-    starts = _merged_starts(order, classes.rep, classes.sign, members)
+    starts = _merged_starts(col, classes.rep, classes.sign, members)
     if isinstance(starts, str):
         return starts
     keep = np.ones(n, dtype=bool)
@@ -144,48 +146,63 @@ def _array_link(eq: ArrayEquation, col: Collected) -> tuple[np.ndarray, np.ndarr
     return a, b, -sb / sa
 
 
-def _ranks(order: list[Any], names: list[str], heads: np.ndarray,
-           tails: np.ndarray) -> list[int]:
+def _ranks(col: Collected, heads: np.ndarray, tails: np.ndarray) -> list[int]:
     """:func:`bgmodelica.passes.alias._ranks` on the collected columns: the dense rank of
     (has a derivative, state priority, fixed start, fewer dots, shorter name) among the
     linked variables, 0 for the others."""
-    mask = np.zeros(len(order), dtype=bool)
+    n = len(col.order)
+    mask = np.zeros(n, dtype=bool)
     mask[heads] = True
     mask[tails] = True
     linked = np.flatnonzero(mask)
+    keys = _rank_keys(col, linked)
+    keys -= keys.min(axis=0)                 # one integer, ordered as the tuples are
+    code = np.zeros(linked.size, dtype=np.int64)
+    for column in keys.T:
+        code = code * (int(column.max()) + 1) + column
+    _, dense = np.unique(code, return_inverse=True)
+    out = np.zeros(n, dtype=np.int64)
+    out[linked] = dense.ravel()
+    return out.tolist()
+
+
+def _rank_keys(col: Collected, linked: np.ndarray) -> np.ndarray:
+    """The rank key of each linked column, one row each."""
+    t = col.traits
+    if t is not None:
+        return np.column_stack((t.has_der[linked], t.state_select[linked], t.fixed[linked],
+                                -t.dots[linked], -t.length[linked])).astype(np.int64)
     at = linked.tolist()
-    syms = list(map(order.__getitem__, at))
+    syms = list(map(col.order.__getitem__, at))
     decls = list(map(_DECL, syms))
-    texts = list(map(names.__getitem__, at))
-    keys = np.column_stack((
+    texts = list(map(col.names.__getitem__, at))
+    return np.column_stack((
         np.fromiter(map(is_not, map(_DER, syms), repeat(None)), np.int64, len(at)),
         np.fromiter(map(int, map(_STATE_SELECT, decls)), np.int64, len(at)),
         np.fromiter(map(bool, map(_FIXED, decls)), np.int64, len(at)),
         -np.fromiter(map(methodcaller("count", "."), texts), np.int64, len(at)),
         -np.fromiter(map(len, texts), np.int64, len(at))))
-    keys -= keys.min(axis=0)                 # one integer, ordered as the tuples are
-    code = np.zeros(len(at), dtype=np.int64)
-    for column in keys.T:
-        code = code * (int(column.max()) + 1) + column
-    _, dense = np.unique(code, return_inverse=True)
-    out = np.zeros(len(order), dtype=np.int64)
-    out[linked] = dense.ravel()
-    return out.tolist()
 
 
-def _merged_starts(order: list[Any], rep: list[int], sign: list[float],
+def _merged_starts(col: Collected, rep: list[int], sign: list[float],
                    members: list[int]) -> dict[int, tuple[float, bool]] | str:
     """:func:`bgmodelica.passes.alias._merge_metadata` for start values: each member's fixed
     start carried to its representative (a conflict is left to the scalar pipeline, which
     names it), or a nonzero guess to a representative starting at 0 without a fixed one."""
+    order, t = col.order, col.traits
     current: dict[int, tuple[float, bool]] = {}
-    decls = list(map(_DECL, (order[i] for i in members)))
     # only members with a fixed or nonzero start change their representative's start
-    matter = np.flatnonzero(np.fromiter(map(attrgetter("fixed"), decls), bool, len(decls))
-                            | (np.fromiter(map(attrgetter("start"), decls), float,
-                                           len(decls)) != 0))
-    for k in matter.tolist():
-        i, dv = members[k], decls[k]
+    if t is not None:
+        at = np.asarray(members, dtype=np.int64)
+        matter = np.flatnonzero(t.fixed[at] | (t.start[at] != 0)).tolist()
+    else:
+        decls = list(map(_DECL, map(order.__getitem__, members)))
+        matter = np.flatnonzero(
+            np.fromiter(map(_FIXED, decls), bool, len(decls))
+            | (np.fromiter(map(attrgetter("start"), decls), float, len(decls)) != 0)).tolist()
+    for k in matter:
+        i = members[k]
+        dv = order[i].decl
         r = rep[i]
         r_start, r_fixed = current.get(r, (float(order[r].decl.start), bool(order[r].decl.fixed)))
         if dv.fixed:

@@ -42,6 +42,21 @@ MAX_SCALAR_EQUATIONS = 256
 
 
 @dataclass
+class Traits:
+    """What alias elimination reads of each column (variable or derivative), as arrays:
+    whether it has a time derivative (``has_der``), is one (``is_der``), its ``fixed``,
+    ``state_select`` and ``start``, and the dots and length of its name."""
+
+    has_der: np.ndarray
+    is_der: np.ndarray
+    fixed: np.ndarray
+    state_select: np.ndarray
+    start: np.ndarray
+    dots: np.ndarray
+    length: np.ndarray
+
+
+@dataclass
 class Collected:
     """A model the array path takes: ``order`` holds its variables in the order of the
     scalar pipeline (each variable followed by its time derivative, if used), ``params`` its
@@ -51,7 +66,8 @@ class Collected:
     as tables). ``names`` and ``param_names`` are their dotted names (``scoped``: the
     symbols' own names are not: a model of components), ``param_owners`` the components
     declaring the parameters (None: the top level); ``sources`` the equations as written
-    with their origins for the unit check (None: all written at ``where``). ``pos`` maps
+    with their origins for the unit check (None: all written at ``where``), ``traits`` the
+    columns' :class:`Traits` when known at once (None: read off the symbols). ``pos`` maps
     ``id(symbol)`` to its column (variables and derivatives, then parameters, then time) and
     ``memo`` the declared arrays to their columns (as
     :func:`~bgmodelica.core.flatten_arrays.residual` reads them)."""
@@ -70,6 +86,7 @@ class Collected:
     param_owners: list[str] | None = None
     sources: Any = None
     scoped: bool = False
+    traits: Traits | None = None
 
     def __post_init__(self) -> None:
         if not self.names:

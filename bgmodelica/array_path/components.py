@@ -18,7 +18,7 @@ level, initial equations, events) goes the scalar way.
 from __future__ import annotations
 
 from itertools import chain, repeat
-from operator import add, attrgetter, is_not, itemgetter
+from operator import add, attrgetter, is_not, itemgetter, methodcaller
 from typing import Any
 
 import numpy as np
@@ -42,11 +42,12 @@ from ..core.variables import (
     Potential,
     Variable,
 )
-from .collect import SOFT_STATE_SELECT, Collected
+from .collect import SOFT_STATE_SELECT, Collected, Traits
 from .connections import LinearRows, set_rows
 
 _DECL, _DER, _STATE_SELECT = attrgetter("decl"), attrgetter("der"), attrgetter("state_select")
 _A, _B = attrgetter("a"), attrgetter("b")
+_FIXED, _START = attrgetter("fixed"), attrgetter("start")
 _VALUE, _SYMBOLS, _CHILDREN = attrgetter("value"), attrgetter("_symbols"), attrgetter("_children")
 _VARIABLES = (Variable, Output, Potential, Flow)
 _NUMBERS = (int, float, np.integer, np.floating)
@@ -82,7 +83,8 @@ def collect_components(model: Component, minimum: int) -> Any:
     memo = _memo(equations.groups, cols, children)
     sources = EquationSources(groups=_scalar_groups(equations.scalars), arrays=equations.arrays)
     return Collected(name, where, cols.order, cols.params, all_equations, n_rows, pos, memo,
-                     0, cols.names, cols.param_names, cols.param_owners, sources, True)
+                     0, cols.names, cols.param_names, cols.param_owners, sources, True,
+                     cols.traits)
 
 
 def _shape_check(model: Component, children: dict[str, Any], minimum: int) -> str | None:
@@ -247,6 +249,7 @@ class _Columns:
         self.columns = np.full((n_c, max(width, 1)), -1, dtype=np.int64)
         self.connector: dict[int, int] = {}
         pos = _Positions()
+        traits = self.traits = _traits(n)
         for at, layout, subs in slots:
             col, p_col = base[at].copy(), p_base[at].copy()
             for j, (_, _, keys) in enumerate(subs):
@@ -268,12 +271,14 @@ class _Columns:
                     continue
                 order[col] = _objects(slot.symbols)
                 names[col] = slot.names
+                traits.fill(col, slot)
                 slot.columns = col.copy()
                 pos.add(slot.symbols, slot.columns, at.size < GROUP_FROM)
                 if slot.sub >= 0:
                     self.columns[c_base[at] + slot.sub, slot.index] = col
                 if slot.has_der.any():
                     has = slot.has_der.astype(bool)
+                    traits.is_der[col[has] + 1] = True
                     ders = [d for d in slot.ders if d is not None]
                     order[col[has] + 1] = _objects(ders)
                     names[col[has] + 1] = [f"der({x})" for x in np.asarray(slot.names,
@@ -324,6 +329,7 @@ class _Columns:
                 return "a variable has a state selection"
             slot = _Slot(sub, index, key, "flow" if decl_type is Flow else "variable", symbols,
                          where, owners)
+            slot.decls = decls
             if slot.has_der.any() and any(d.der is not None for d in slot.ders if d is not None):
                 return "a variable has a second derivative"
             out.add(slot, None if sub < 0 else sub_names[sub])
@@ -361,11 +367,32 @@ class _Slot:
         self.sub, self.index, self.kind, self.symbols = sub, index, kind, symbols
         self.key = key
         self.columns: np.ndarray = np.zeros(0, dtype=np.int64)     # set by _Columns
+        self.decls: list[Any] = []                                  # (variables)
         self.names = list(map(add, where, repeat(f".{key}")))
         self.owners = owners
         self.ders = list(map(_DER, symbols))
         self.has_der = np.fromiter(map(is_not, self.ders, repeat(None)), np.int64,
                                    len(symbols))
+
+
+def _traits(n: int) -> Traits:
+    """:class:`~.collect.Traits` of ``n`` columns, to be filled slot by slot."""
+    return _FillTraits(np.zeros(n, dtype=bool), np.zeros(n, dtype=bool),
+                       np.zeros(n, dtype=bool), np.zeros(n, dtype=np.int64),
+                       np.zeros(n, dtype=float), np.zeros(n, dtype=np.int64),
+                       np.zeros(n, dtype=np.int64))
+
+
+class _FillTraits(Traits):
+    def fill(self, col: np.ndarray, slot: _Slot) -> None:
+        """The traits of a slot's variables, at their columns ``col``."""
+        k, decls, names = col.size, slot.decls, slot.names
+        self.has_der[col] = slot.has_der.astype(bool)
+        self.fixed[col] = np.fromiter(map(bool, map(_FIXED, decls)), bool, k)
+        self.state_select[col] = np.fromiter(map(int, map(_STATE_SELECT, decls)), np.int64, k)
+        self.start[col] = np.fromiter(map(float, map(_START, decls)), float, k)
+        self.dots[col] = np.fromiter(map(methodcaller("count", "."), names), np.int64, k)
+        self.length[col] = np.fromiter(map(len, names), np.int64, k)
 
 
 class _Positions(dict):
