@@ -1,9 +1,10 @@
-"""The array path: large leaf models of array equations compiled without a Python object
-per scalar.
+"""The array path: large models compiled without a Python object per scalar.
 
-``compile`` sends a model here first (:func:`compile_arrays`). A model it takes (see
-:mod:`.collect`) is lowered to MX blocks (:mod:`.lowering`), its aliases eliminated
-(:mod:`.aliases`), ordered on its integer incidence
+Two kinds of model take it: a leaf model of array equations (:mod:`.collect`), and a model
+of many leaf components joined by ``connect`` (:mod:`.components`, its connection sets as
+linear rows: :mod:`.connections`). ``compile`` sends a model here first
+(:func:`compile_arrays`). A model it takes is lowered to MX blocks (:mod:`.lowering`), its
+aliases eliminated (:mod:`.aliases`), ordered on its integer incidence
 (:mod:`bgmodelica.structure.explicit_order`), solved block by block and assembled into the
 same :class:`~bgmodelica.backends.casadi_dae.CasadiDAE` the scalar pipeline builds: the same
 variable names and order, states, parameters, start values and ODE. A model it does not take,

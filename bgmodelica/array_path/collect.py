@@ -4,7 +4,8 @@ The array path (:mod:`bgmodelica.array_path`) compiles a *leaf* model written wi
 equations without making a Python object per scalar. It takes a model only when the result
 is the one the scalar pipeline gives; anything else goes the usual way:
 
-- one component, without subcomponents, connectors, connections or initial equations;
+- one component, without subcomponents, connectors, connections or initial equations (a
+  model of leaf components joined by ``connect`` is collected by :mod:`.components`);
 - plain :class:`~bgmodelica.core.variables.Variable` and
   :class:`~bgmodelica.core.variables.Output` (state selection at most ``PREFER`` or ``AVOID``),
   :class:`~bgmodelica.core.variables.Parameter` and
