@@ -605,3 +605,22 @@ def test_the_scalar_structures_of_a_ladder_are_made_on_first_use():
     assert compiled.timings["scalar_structures"] > 0
     assert compiled.dae is not before
     _same_dae(before, compiled.dae)
+
+
+def test_summary_pickling_and_parameter_overrides_match_the_scalar_pipeline():
+    from bgmodelica.studies.payload import pickle_compiled, unpickle_compiled
+
+    compiled = bg.compile(RCLadder(1200))
+    assert isinstance(compiled, ArrayCompiledModel)
+    slow = bg.compile(RCLadder(1200), array_path=False)
+    mine, theirs = compiled.summary(), slow.summary()
+    assert {k: v for k, v in mine.items() if k != "compile_seconds"} == \
+        {k: v for k, v in theirs.items() if k != "compile_seconds"}
+    assert "reduced" not in compiled.__dict__             # read off the array path's result
+    back = unpickle_compiled(pickle_compiled(compiled))
+    runs = [bg.simulate(m, stop_time=0.05, interval=0.01, outputs=["C7.v", "R5.i"],
+                        params={"R5.R": 2.0}, **TIGHT) for m in (compiled, back, slow)]
+    for res in runs[1:]:
+        assert np.max(np.abs(res["C7.v"] - runs[0]["C7.v"])) < 1e-12
+        assert np.max(np.abs(res["R5.i"] - runs[0]["R5.i"])) < 1e-12
+    assert runs[0].parameters["R5.R"] == 2.0 and runs[0].units["R5.i"] == "A"
