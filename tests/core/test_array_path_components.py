@@ -624,3 +624,19 @@ def test_summary_pickling_and_parameter_overrides_match_the_scalar_pipeline():
         assert np.max(np.abs(res["C7.v"] - runs[0]["C7.v"])) < 1e-12
         assert np.max(np.abs(res["R5.i"] - runs[0]["R5.i"])) < 1e-12
     assert runs[0].parameters["R5.R"] == 2.0 and runs[0].units["R5.i"] == "A"
+
+
+def test_fmu_export_of_a_model_of_components_from_the_array_path(tmp_path):
+    from fmpy import simulate_fmu
+
+    from bgmodelica.fmi.from_model import export_model
+
+    n, volts = 3, 2.0
+    compiled = compile_arrays(ParallelRC(n, V=volts), minimum=0)
+    assert compiled is not None
+    fmu = export_model(compiled, tmp_path, fmi_version=2, fmu_type="cs")
+    assert "flat" in compiled.__dict__           # export completed the scalar structures
+    out = simulate_fmu(str(fmu), stop_time=1.0, output=["C2.v", "R2.i"], output_interval=0.5)
+    tau = _branch_r(2, n) * _branch_c(2, n)
+    assert abs(out["C2.v"][-1] - volts * (1 - np.exp(-1.0 / tau))) < 1e-4
+    assert abs(out["R2.i"][-1] - volts / _branch_r(2, n) * np.exp(-1.0 / tau)) < 1e-4
