@@ -150,15 +150,14 @@ def cmd_check(args: argparse.Namespace) -> int:
     print(f"  flat equations {summary['flat_equations_before_alias_elimination']}, "
           f"aliases eliminated {summary['aliases_eliminated']}")
     print(f"  structural index: {summary['structural_index']}")
-    print(f"  states ({len(summary['states'])}): "
-          f"{', '.join(compact_names(summary['states'])) or '-'}")
+    print(f"  states ({len(summary['states'])}): {_listed(summary['states'])}")
     if summary["dummy_derivatives"]:
         print(f"  dummy derivatives: {', '.join(compact_names(summary['dummy_derivatives']))}")
     if summary["differentiated_equations"]:
         print(f"  differentiated equations ({len(summary['differentiated_equations'])}): "
               + "; ".join(summary["differentiated_equations"][:8]))
     print(f"  algebraic variables ({len(summary['algebraic_variables'])}): "
-          + (", ".join(compact_names(summary["algebraic_variables"])[:20]) or "-"))
+          + _listed(summary["algebraic_variables"], 20))
     loops = summary["algebraic_loops"]
     print(f"  algebraic loops: {len(loops)}"
           + "".join(f"\n    size {lp['size']} ({lp['kind']}), tearing: "
@@ -225,6 +224,16 @@ def cmd_draw(args: argparse.Namespace) -> int:
     path = draw(model, args.output)
     print(f"drawing -> {path}")
     return 0
+
+
+def _listed(names: list[str], most: int = 40) -> str:
+    """Names for a report line: runs collapsed, at most ``most`` items, then how many more."""
+    from .core.arrays import compact_names
+
+    items = compact_names(names)
+    if len(items) <= most:
+        return ", ".join(items) or "-"
+    return ", ".join(items[:most]) + f", ... ({len(items) - most} more; --json lists all)"
 
 
 def _structural_vs_numeric(model: Any, compiled: Any, report: Any) -> Any:

@@ -442,37 +442,48 @@ def connect_arrays(a: Any, b: Any, make: Any) -> list[Any]:
 
 
 def compact_names(names: list[str]) -> list[str]:
-    """``x[1], x[2], x[3]`` -> ``x[1:3]``: runs of consecutive elements of one array
-    collapsed (order kept), for reports."""
+    """``x[1], x[2], x[3]`` -> ``x[1:3]``, and ``C1.v, C2.v, ..., C9.v`` -> ``C1.v .. C9.v``
+    (three or more components numbered in a row, as a ladder's sections are named): runs
+    of consecutive elements collapsed (order kept), for reports."""
     out: list[str] = []
-    run_base, run_first, run_last = None, 0, 0
+    run: list[Any] = []         # [kind, base, tail, first, last]: kind "[" or "#"
 
     def flush() -> None:
-        if run_base is None:
+        if not run:
             return
-        if run_last > run_first:
-            out.append(f"{run_base}[{run_first}:{run_last}]{run_tail}")
+        kind, base, tail, first, last = run
+        if kind == "[":
+            out.append(f"{base}[{first}:{last}]{tail}" if last > first
+                       else f"{base}[{first}]{tail}")
+        elif last - first >= 2:
+            out.append(f"{base}{first}{tail} .. {base}{last}{tail}")
         else:
-            out.append(f"{run_base}[{run_first}]{run_tail}")
+            out.extend(f"{base}{k}{tail}" for k in range(first, last + 1))
+        run.clear()
 
-    run_tail = ""
     for name in names:
         head, tail = _split_index(name)
+        kind = "["
+        if head is None:
+            m = _NUMBERED.match(name)
+            if m is not None:
+                head, tail, kind = (m.group(1), int(m.group(2))), m.group(3), "#"
         if head is not None:
             base, index = head
-            if base == run_base and tail == run_tail and index == run_last + 1:
-                run_last = index
+            if run and run[:3] == [kind, base, tail] and index == run[4] + 1:
+                run[4] = index
                 continue
             flush()
-            run_base, run_first, run_last, run_tail = base, index, index, tail
+            run.extend([kind, base, tail, index, index])
             continue
         flush()
-        run_base = None
         out.append(name)
     flush()
     return out
 
 
+#: ``C12.v`` -> (``C``, 12, ``.v``): a component numbered at the end of its name
+_NUMBERED = re.compile(r"^(.*?[A-Za-z_])(\d+)((?:\.[^\[\]]*)?)$")
 _LAST_INDEX = re.compile(r"^(.*?)\[(\d+)\]([^\[]*)$")
 
 

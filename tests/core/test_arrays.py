@@ -91,6 +91,21 @@ def test_element_names_and_compact_names():
     assert element_names("A", (2, 2)) == ["A[1,1]", "A[1,2]", "A[2,1]", "A[2,2]"]
     names = ["v[1]", "v[2]", "v[3]", "w", "C[1].v", "C[2].v", "C[4].v", "der(x[1])"]
     assert compact_names(names) == ["v[1:3]", "w", "C[1:2].v", "C[4].v", "der(x[1])"]
+    # components numbered in a row (a ladder's sections): three or more collapse
+    names = ["C1.v", "C2.v", "C3.v", "C5.v", "R7.i", "R8.i", "x1", "mass1.s", "mass2.s",
+             "der(C1.v)"]
+    assert compact_names(names) == ["C1.v .. C3.v", "C5.v", "R7.i", "R8.i", "x1",
+                                    "mass1.s", "mass2.s", "der(C1.v)"]
+
+
+def test_check_lists_long_name_lists_briefly():
+    from bgmodelica.cli import _listed
+
+    assert _listed([f"C{k}.v" for k in range(1, 10001)]) == "C1.v .. C10000.v"
+    mixed = [f"m{k}.{x}" for k in range(1, 101) for x in ("s", "v")]    # no runs
+    text = _listed(mixed)
+    assert text.startswith("m1.s, m1.v, m2.s") and text.endswith("(160 more; --json lists all)")
+    assert _listed([]) == "-"
 
 
 def test_array_of_components_connect_broadcast_and_mismatch():
