@@ -34,6 +34,7 @@ from .aliases import find_aliases
 from .build import assemble, solve_blocks
 from .collect import ARRAY_PATH_FROM, collect
 from .lowering import Lowered
+from .scalars import group_scalars
 
 __all__ = ["ARRAY_PATH_FROM", "ArrayCompiledModel", "compile_arrays", "why_not"]
 
@@ -87,6 +88,7 @@ def _build(model: Any, units: str, minimum: int | None) -> ArrayCompiledModel | 
 def _compile_blocks(col: Any, lap: Any) -> Any:
     """The :class:`~bgmodelica.backends.casadi_dae.CasadiDAE` of a collected model, or why
     its equations do not solve explicitly block by block."""
+    col.equations = group_scalars(col.equations)
     low = Lowered(col)
     aliases = find_aliases(col)
     if isinstance(aliases, str):

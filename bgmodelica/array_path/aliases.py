@@ -2,9 +2,10 @@
 as the scalar pipeline eliminates them (:mod:`bgmodelica.passes.alias`): the same links in
 the same order, the same ranking of representatives and the same signed classes
 (:func:`bgmodelica.structure.alias.alias_classes`), the same merge of fixed start values.
-A model where that elimination would do more (a cycle of links, an alias of a
-differentiated variable, conflicting fixed starts, an array equation only partly of aliases)
-goes the scalar way.
+An equation whose rows are only partly alias links (``y == k`` with a parameter ``k`` in
+a group of ``a == b``) keeps its other rows. A model where the elimination would do more
+(a cycle of links, an alias of a differentiated variable, conflicting fixed starts) goes
+the scalar way.
 """
 
 from __future__ import annotations
@@ -18,11 +19,11 @@ import numpy as np
 
 from ..core.arrays import ArrayEquation
 from ..core.expr import alias_signs
-from ..core.flatten import _side_shape
 from ..core.flatten_arrays import _rows, alias_form
 from ..structure.alias import alias_classes
 from .collect import Collected
 from .connections import LinearRows
+from .scalars import ScalarGroup
 
 _DECL, _DER, _DER_OF = attrgetter("decl"), attrgetter("der"), attrgetter("der_of")
 _STATE_SELECT, _FIXED = attrgetter("state_select"), attrgetter("fixed")
@@ -31,15 +32,16 @@ _STATE_SELECT, _FIXED = attrgetter("state_select"), attrgetter("fixed")
 @dataclass
 class Aliases:
     """The eliminated columns and what they read as: column ``k`` is ``sign[k] *
-    column target[k]``; ``keep`` are the columns left (ascending), ``dropped`` the indices
-    (in ``Collected.equations``) of the alias equations, ``names`` the eliminated names
+    column target[k]``; ``keep`` are the columns left (ascending), ``dropped`` the alias
+    equations (index in ``Collected.equations`` -> which of its rows), ``names`` the
+    eliminated names
     with their representatives and signs, ``starts`` the merged ``(start, fixed)`` of the
     representatives whose start values changed."""
 
     keep: np.ndarray
     target: np.ndarray
     sign: np.ndarray
-    dropped: set[int]
+    dropped: dict[int, np.ndarray]
     names: dict[str, tuple[str, float]]
     starts: dict[int, tuple[float, bool]]
 
@@ -57,8 +59,9 @@ def find_aliases(col: Collected) -> Aliases | str | None:
     factors: list[np.ndarray] = []
     linked_rows: dict[int, np.ndarray] = {}   # equation -> which of its rows are links
 
-    def add(k: int, a: np.ndarray, b: np.ndarray, factor: float | np.ndarray) -> None:
-        ok = plain[a] & plain[b] & (a != b)
+    def add(k: int, a: np.ndarray, b: np.ndarray, factor: float | np.ndarray,
+            mask: np.ndarray | bool = True) -> None:
+        ok = plain[a] & plain[b] & (a != b) & mask
         linked_rows[k] = ok
         heads.append(a[ok])
         tails.append(b[ok])
@@ -69,21 +72,14 @@ def find_aliases(col: Collected) -> Aliases | str | None:
     for k, eq in enumerate(col.equations):
         if isinstance(eq, LinearRows) and eq.links is not None:
             add(k, *eq.links)
-    groups: dict[Any, list[tuple[int, list, list]]] = {}
     for k, eq in enumerate(col.equations):
-        if not isinstance(eq, (ArrayEquation, LinearRows)):
-            leaves: list = []
-            consts: list = []
-            key = (_side_shape(eq.lhs, leaves, consts), _side_shape(eq.rhs, leaves, consts))
-            groups.setdefault(key, []).append((k, leaves, consts))
-    for key, members in groups.items():
-        signs = alias_signs(*key)
-        if not signs:
-            continue
-        for k, leaves, consts in members:
-            if not any(consts):
-                a, b = (np.array([_column(pos, s, n)]) for s in leaves[:2])
-                add(k, a, b, -signs[1] / signs[0])
+        if isinstance(eq, ScalarGroup):
+            signs = alias_signs(*eq.key)
+            if signs:
+                a, b = (np.array([_column(pos, leaves[j], n) for leaves in eq.leaves],
+                                 dtype=np.int64) for j in (0, 1))
+                add(k, a, b, -signs[1] / signs[0],
+                    np.array([not any(c) for c in eq.consts], dtype=bool))
     for k, eq in enumerate(col.equations):
         if isinstance(eq, ArrayEquation):
             found = _array_link(eq, col)
@@ -93,12 +89,7 @@ def find_aliases(col: Collected) -> Aliases | str | None:
     if not links_a.size:
         return None
     links_b, signs_ = np.concatenate(tails), np.concatenate(factors)
-    dropped = set()
-    for k, ok in linked_rows.items():
-        if ok.all():
-            dropped.add(k)
-        elif ok.any():
-            return "an array equation is partly of aliases"
+    dropped = {k: ok for k, ok in linked_rows.items() if ok.any()}
     names_of = col.names
     ranks = _ranks(col, links_a, links_b)
     links = zip(links_a.tolist(), links_b.tolist(), signs_.tolist(), strict=True)

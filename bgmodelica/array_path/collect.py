@@ -10,10 +10,10 @@ is the one the scalar pipeline gives; anything else goes the usual way:
   :class:`~bgmodelica.core.variables.Output` (state selection at most ``PREFER`` or ``AVOID``),
   :class:`~bgmodelica.core.variables.Parameter` and
   :class:`~bgmodelica.core.variables.Input` declarations, parameters given as numbers;
-- equations that are array equations lowered as blocks, or a few scalar equations, built
-  from whole-array arithmetic and the smooth math functions (no relations, events or
-  ``if_else``); aliases ``a == b`` between variables are eliminated as the scalar pipeline
-  eliminates them (:mod:`.aliases`);
+- equations that are array equations lowered as blocks, or scalar equations (lowered in
+  groups of one shape), built from whole-array arithmetic and the smooth math functions
+  (no relations, events or ``if_else``); aliases ``a == b`` between variables are
+  eliminated as the scalar pipeline eliminates them (:mod:`.aliases`);
 - at least :data:`ARRAY_PATH_FROM` scalar equations (below, the scalar pipeline is as fast).
 """
 
@@ -38,9 +38,6 @@ from ..core.variables import TIME, Input, Output, Parameter, StateSelect, Symbol
 SOFT_STATE_SELECT = frozenset((StateSelect.DEFAULT, StateSelect.PREFER, StateSelect.AVOID))
 #: the array path is used from this many scalar equations on
 ARRAY_PATH_FROM = 1000
-#: at most this many scalar (non-array) equations: each is lowered on its own
-MAX_SCALAR_EQUATIONS = 256
-
 
 @dataclass
 class Traits:
@@ -140,14 +137,11 @@ def collect(model: Any, minimum: int | None = None) -> Collected | str:
     name = model.name or type(model).__name__
     where = f"top level ({type(model).__name__})"
     equations = guarded_equations(model, where, "", blocks=True)
-    n_rows = n_scalar = 0
+    n_rows = 0
     for eq in equations:
         if isinstance(eq, ArrayEquation):
             n_rows += len(eq)
         elif type(eq) is Equation:
-            n_scalar += 1
-            if n_scalar > MAX_SCALAR_EQUATIONS:
-                return "many scalar equations"
             if not (_block_operand(eq.lhs) and _block_operand(eq.rhs)):
                 return "a scalar equation is not smooth arithmetic"
             n_rows += 1

@@ -51,9 +51,6 @@ _FIXED, _START = attrgetter("fixed"), attrgetter("start")
 _VALUE, _SYMBOLS, _CHILDREN = attrgetter("value"), attrgetter("_symbols"), attrgetter("_children")
 _VARIABLES = (Variable, Output, Potential, Flow)
 _NUMBERS = (int, float, np.integer, np.floating)
-#: at most this many scalar equations of components asked one by one
-MAX_SCALAR_EQUATIONS = 256
-
 
 def collect_components(model: Component, minimum: int) -> Any:
     """The :class:`~.collect.Collected` of a model of leaf components, or why it goes the
@@ -67,7 +64,8 @@ def collect_components(model: Component, minimum: int) -> Any:
     equations = _Equations(model, children, where)
     if equations.refused is not None:
         return equations.refused
-    cols = _Columns(children, [items for items, _ in equations.groups])
+    elements = {"": model, **children} if model._symbols else children   # in tree order
+    cols = _Columns(elements, [items for items, _ in equations.groups])
     if cols.refused is not None:
         return cols.refused
     rows = _connections(equations.links, cols)
@@ -80,7 +78,7 @@ def collect_components(model: Component, minimum: int) -> Any:
         return "small"
     pos = cols.pos
     pos[id(TIME)] = cols.n + len(cols.params)
-    memo = _memo(equations.groups, cols, children)
+    memo = _memo(equations.groups, cols, elements)
     sources = EquationSources(groups=_scalar_groups(equations.scalars), arrays=equations.arrays)
     return Collected(name, where, cols.order, cols.params, all_equations, n_rows, pos, memo,
                      0, cols.names, cols.param_names, cols.param_owners, sources, True,
@@ -90,8 +88,6 @@ def collect_components(model: Component, minimum: int) -> Any:
 def _shape_check(model: Component, children: dict[str, Any], minimum: int) -> str | None:
     """Why the tree is not leaf components under a top level of connections (None: it is),
     or "small"."""
-    if model._symbols:
-        return "it has variables beside subcomponents"
     if "_arrays" in model.__dict__ and any(not isinstance(c, Component)
                                            for c in children.values()):
         return "it has arrays of connectors"
@@ -131,9 +127,13 @@ class _Equations:
         self.arrays: list[tuple[ArrayEquation, str, list[str] | None]] = []
         self.refused: str | None = None
         self.groups: list[tuple[list[Any], dict]] = []     # (components, arrays they read)
-        self.links = guarded_equations(model, where, "", blocks=True)
-        if set(map(type, self.links)) - {Connection} or not _connectors_only(self.links):
-            self.refused = "the top level has equations other than connections of connectors"
+        top = guarded_equations(model, where, "", blocks=True)
+        self.links = [eq for eq in top if type(eq) is Connection]
+        if not _connectors_only(self.links):
+            self.refused = "the top level connects signals"
+            return
+        if len(self.links) < len(top) and not self._take(
+                [eq for eq in top if type(eq) is not Connection], where):
             return
         done: set[int] = set()
         if len(children) >= GROUP_FROM or "_arrays" in model.__dict__:
@@ -153,19 +153,22 @@ class _Equations:
             if id(child) in done:
                 continue
             where = f"{path} ({type(child).__name__})"
-            for eq in guarded_equations(child, where, path, blocks=True):
-                if isinstance(eq, ArrayEquation):
-                    self.arrays.append((eq, where, None))
-                elif type(eq) is Equation and _block_operand(eq.lhs) \
-                        and _block_operand(eq.rhs):
-                    self.scalars.append((eq, where))
-                    if len(self.scalars) > MAX_SCALAR_EQUATIONS:
-                        self.refused = "many scalar equations"
-                        return
-                else:
-                    self.refused = f"{where} has an equation that is not smooth arithmetic"
-                    return
-                self.items.append(eq)
+            if not self._take(guarded_equations(child, where, path, blocks=True), where):
+                return
+
+    def _take(self, equations: list[Any], where: str) -> bool:
+        """Add the equations of one component (False, with ``refused`` set, if they are not
+        for the array path)."""
+        for eq in equations:
+            if isinstance(eq, ArrayEquation):
+                self.arrays.append((eq, where, None))
+            elif type(eq) is Equation and _block_operand(eq.lhs) and _block_operand(eq.rhs):
+                self.scalars.append((eq, where))
+            else:
+                self.refused = f"{where} has an equation that is not smooth arithmetic"
+                return False
+            self.items.append(eq)
+        return True
 
 
 def _connectors_only(links: list[Connection]) -> bool:
@@ -190,15 +193,19 @@ class _Columns:
     whether each is a flow, ``columns``: their variables' columns)."""
 
     def __init__(self, children: dict[str, Any], checked: list[list[Any]]) -> None:
-        """``checked``: groups of components known to share their declarations (written
-        once)."""
+        """``children`` by path in tree order (the top level first, as ``""``, when it
+        declares variables or parameters); ``checked``: groups of components known to share
+        their declarations (written once)."""
         self.refused: str | None = None
         paths = list(children)
         items = list(children.values())
         by_class: dict[Any, list[int]] = {}
-        for k, child in enumerate(items):
-            by_class.setdefault(type(child), []).append(k)
         by_layout: dict[Any, list[int]] = {}
+        for k, child in enumerate(items):
+            if paths[k] == "":          # the top level: its own declarations only
+                by_layout[(None, tuple(child._symbols), ())] = [k]
+                continue
+            by_class.setdefault(type(child), []).append(k)
         for cls, members in by_class.items():
             group = [items[k] for k in members]
             if any(map(group.__eq__, checked)) or _same_keys(group):   # one layout per class
@@ -368,7 +375,7 @@ class _Slot:
         self.key = key
         self.columns: np.ndarray = np.zeros(0, dtype=np.int64)     # set by _Columns
         self.decls: list[Any] = []                                  # (variables)
-        self.names = list(map(add, where, repeat(f".{key}")))
+        self.names = [key] if where == [""] else list(map(add, where, repeat(f".{key}")))
         self.owners = owners
         self.ders = list(map(_DER, symbols))
         self.has_der = np.fromiter(map(is_not, self.ders, repeat(None)), np.int64,

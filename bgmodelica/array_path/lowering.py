@@ -16,10 +16,12 @@ import casadi as ca
 import numpy as np
 
 from ..core.arrays import ArrayEquation, ArrayExpr
-from ..core.expr import Expr, apply_op, lower_tree
+from ..core.expr import Expr, apply_op, lower_group, lower_tree
+from ..core.flatten import _count
 from ..core.flatten_arrays import _rows
 from .collect import Collected
 from .connections import LinearRows
+from .scalars import ScalarGroup
 
 
 class Lowered:
@@ -42,6 +44,10 @@ class Lowered:
             if isinstance(eq, LinearRows):
                 self._linear(eq, start, rows, cols)
                 start += eq.size
+                continue
+            if isinstance(eq, ScalarGroup):
+                self._group(eq, start, rows, cols)
+                start += len(eq)
                 continue
             shape = eq.shape if isinstance(eq, ArrayEquation) else ()
             size = int(np.prod(shape))
@@ -71,14 +77,49 @@ class Lowered:
         rows.append(eq.rows + start)
         cols.append(eq.cols)
 
-    def eliminate(self, dropped: set[int], target: np.ndarray, sign: np.ndarray) -> None:
-        """Drop the blocks ``dropped`` (alias equations) and read every column ``k`` of
-        ``x`` as ``sign[k] * x[target[k]]`` in the others (the eliminated aliases)."""
+    def _group(self, group: ScalarGroup, start: int, rows: list, cols: list) -> None:
+        """Scalar equations of one shape as one block on their leaves' columns."""
+        size = len(group)
+        of = self.pos.of
+        idx = np.array([[of(sym) for sym in leaves] for leaves in group.leaves],
+                       dtype=np.int64).reshape(size, -1)
+        leaf_vecs = [self._take(idx[:, j]) for j in range(idx.shape[1])]
+        const_vecs: list[Any] = []
+        for j in range(len(group.consts[0])):
+            values = [c[j] for c in group.consts]
+            const_vecs.append(values[0] if values.count(values[0]) == size else ca.DM(values))
+        shape_l, shape_r = group.key
+        n_l, c_l = _count(shape_l, "L"), _count(shape_l, "C")
+        res = lower_group(shape_l, leaf_vecs[:n_l], const_vecs[:c_l]) \
+            - lower_group(shape_r, leaf_vecs[n_l:], const_vecs[c_l:])
+        if not isinstance(res, ca.MX):
+            res = ca.MX(res)
+        if res.numel() != size:
+            res = ca.repmat(res, size, 1)
+        self.blocks.append(res)
+        self.sizes.append(size)
+        rows.append(np.repeat(np.arange(start, start + size, dtype=np.int64), idx.shape[1]))
+        cols.append(idx.ravel())
+
+    def eliminate(self, dropped: dict[int, np.ndarray], target: np.ndarray,
+                  sign: np.ndarray) -> None:
+        """Drop the alias equations (``dropped``: block -> which of its rows) and read every
+        column ``k`` of ``x`` as ``sign[k] * x[target[k]]`` in the others (the eliminated
+        aliases)."""
         starts = np.concatenate([[0], np.cumsum(self.sizes)]).astype(np.int64)
-        kept = [k for k in range(len(self.blocks)) if k not in dropped]
-        row_kept = np.zeros(int(starts[-1]), dtype=bool)
-        for k in kept:
-            row_kept[starts[k]:starts[k + 1]] = True
+        row_kept = np.ones(int(starts[-1]), dtype=bool)
+        blocks, sizes = [], []
+        for k, block in enumerate(self.blocks):
+            mask = dropped.get(k)
+            if mask is None:
+                blocks.append(block)
+                sizes.append(self.sizes[k])
+                continue
+            row_kept[starts[k]:starts[k + 1]] = ~mask
+            if not mask.all():
+                keep = np.flatnonzero(~mask)
+                blocks.append(block[keep.tolist()])
+                sizes.append(int(keep.size))
         renumber = np.cumsum(row_kept) - 1
         used = row_kept[self.rows]
         cols = self.cols[used]
@@ -88,8 +129,8 @@ class Lowered:
         read = self.x[target.tolist()]
         if (sign != 1.0).any():
             read = read * ca.DM(sign)
-        self.blocks = [ca.substitute(self.blocks[k], self.x, read) for k in kept]
-        self.sizes = [self.sizes[k] for k in kept]
+        self.blocks = [ca.substitute(block, self.x, read) for block in blocks]
+        self.sizes = sizes
 
     def lower(self, x: Any, want: tuple[int, ...]) -> tuple[Any, list[np.ndarray]]:
         """``x`` as an MX column of shape ``want`` (C order) and, per operand array, the

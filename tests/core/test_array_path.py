@@ -482,3 +482,36 @@ def test_the_summary_equals_the_scalar_pipelines_without_building_it(make):
     for summary in (mine, theirs):
         summary.pop("compile_seconds")
     assert mine == theirs
+
+
+class PartlyAliases(Component):
+    """Equations of one shape ``a == b``, some between two variables (aliases), one with a
+    parameter (kept): ``x[k] == w[k]``, ``y == k``, and an array ``z == [x[1], g]`` half
+    alias; ``der(x) = -x``."""
+
+    x = Variable(shape=3, start=[1.0, 2.0, 3.0], fixed=True)
+    w = Variable(shape=3)
+    y = Variable()
+    z = Variable(shape=2)
+    k = Parameter(4.0)
+    g = Parameter(-1.0)
+
+    def equations(self):
+        yield der(self.x) == -self.x
+        yield self.w[0] == self.x[0]
+        yield self.y == self.k
+        yield self.w[1] == self.x[1]
+        yield self.w[2] == self.x[2]
+        yield self.z[0] == self.x[0]
+        yield self.z[1] == self.g
+
+
+def test_equations_partly_of_aliases_keep_their_other_rows():
+    compiled = compile_arrays(PartlyAliases(), minimum=0)
+    assert compiled is not None
+    _same_dae(compiled.dae, _compile(PartlyAliases(), None).dae)
+    assert {"w[1]", "w[2]", "w[3]", "z[1]"} <= set(compiled.dae.aliases)
+    res = bg.simulate(compiled, stop_time=1.0, interval=0.5, outputs=["y", "z[2]", "w[3]"],
+                      **TIGHT)
+    assert res.final("y") == 4.0 and res.final("z[2]") == -1.0
+    assert abs(res.final("w[3]") - 3.0 * np.exp(-1.0)) < 1e-8

@@ -402,6 +402,42 @@ class OwnVariables(RCLadder):
         yield self.total == self.C1.v + self.C2.v
 
 
+class TopParameters(RCLadder):
+    """:class:`RCLadder` with a parameter and a variable of the top level, and an equation
+    of its own: ``total = gain*(C1.v + C2.v)``."""
+
+    gain = Parameter(2.0)
+    total = Variable(unit="V")
+
+    def equations(self):
+        yield self.total == self.gain * (self.C1.v + self.C2.v)
+
+
+@pytest.mark.parametrize("make", [lambda: OwnVariables(3), lambda: TopParameters(70)],
+                         ids=["own-variable", "own-parameter-70"])
+def test_variables_and_equations_of_the_top_level_give_the_scalar_pipelines_dae(make):
+    fast, slow = _fast_and_slow(make)
+    _same_dae(fast.dae, slow.dae)
+    assert "total" in fast.dae.names
+
+
+def test_a_ladder_from_modelica_text_takes_the_array_path():
+    from pathlib import Path
+
+    mo = Path(__file__).resolve().parents[1] / "modelica" / "models" / "circuits.mo"
+    model = bg.load_modelica(mo, "Circuits.RCLadder", n=1200)
+    assert why_not(model) is None            # arrays of components, a parameter n
+    compiled = bg.compile(model)
+    assert isinstance(compiled, ArrayCompiledModel)
+    _same_dae(compiled.dae, _compile(bg.load_modelica(mo, "Circuits.RCLadder", n=1200),
+                                     None).dae)
+    py = bg.simulate(bg.compile(RCLadder(1200)), stop_time=0.05, interval=0.05,
+                     outputs=["C1200.v"], **TIGHT)
+    mo_res = bg.simulate(compiled, stop_time=0.05, interval=0.05, outputs=["C[1200].v"],
+                         **TIGHT)
+    assert abs(py.final("C1200.v") - mo_res.final("C[1200].v")) < 1e-8
+
+
 class StartsAtRest(Capacitor):
     """A capacitor starting from ``der(v) = 0`` (an initial equation)."""
 
@@ -443,11 +479,10 @@ class SignalDriven(Component):
 
 @pytest.mark.parametrize(("make", "reason"), [
     (Nested, "a subcomponent has subcomponents"),
-    (lambda: OwnVariables(3), "it has variables beside subcomponents"),
     (WithInitialEquations, "a subcomponent has initial equations"),
-    (SignalDriven, "the top level has equations other than connections of connectors"),
+    (SignalDriven, "the top level connects signals"),
     (lambda: AlwaysMassChain(3), "a variable has a state selection"),
-], ids=["nested", "own-variables", "initial-equations", "signal-connection",
+], ids=["nested", "initial-equations", "signal-connection",
         "state-selection"])
 def test_models_going_the_scalar_way_say_why_and_compile(make, reason):
     found = why_not(make(), minimum=0)
