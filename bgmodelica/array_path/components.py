@@ -23,10 +23,11 @@ from typing import Any
 
 import numpy as np
 
-from ..core.arrays import ArrayEquation, _block_operand
+from ..core.arrays import _SMOOTH_OPS, ArrayEquation
 from ..core.component import Component, Connection, Connector, _own_methods
 from ..core.expr import Equation
 from ..core.flatmodel import EquationSources
+from ..core.flatten import _side_shape
 from ..core.flatten_connections import connection_set_arrays
 from ..core.flatten_vectorized import (
     GROUP_FROM,
@@ -43,7 +44,8 @@ from ..core.variables import (
     Variable,
 )
 from .collect import SOFT_STATE_SELECT, Collected, Traits
-from .connections import LinearRows, set_rows
+from .connections import set_rows
+from .scalars import ScalarGroup
 
 _DECL, _DER, _STATE_SELECT = attrgetter("decl"), attrgetter("der"), attrgetter("state_select")
 _A, _B = attrgetter("a"), attrgetter("b")
@@ -72,14 +74,13 @@ def collect_components(model: Component, minimum: int) -> Any:
     if isinstance(rows, str):
         return rows
     all_equations = [*rows, *equations.items]
-    n_rows = sum(len(eq) if isinstance(eq, (ArrayEquation, LinearRows)) else 1
-                 for eq in all_equations)
+    n_rows = sum(map(len, all_equations))
     if n_rows < minimum:
         return "small"
     pos = cols.pos
     pos[id(TIME)] = cols.n + len(cols.params)
     memo = _memo(equations.groups, cols, elements)
-    sources = EquationSources(groups=_scalar_groups(equations.scalars), arrays=equations.arrays)
+    sources = EquationSources(groups=equations.unit_groups(), arrays=equations.arrays)
     return Collected(name, where, cols.order, cols.params, all_equations, n_rows, pos, memo,
                      0, cols.names, cols.param_names, cols.param_owners, sources, True,
                      cols.traits)
@@ -123,7 +124,7 @@ class _Equations:
         from ..validate import guarded_equations
 
         self.items: list[Any] = []
-        self.scalars: list[tuple[Equation, str]] = []
+        self.shapes: dict[Any, ScalarGroup] = {}     # scalar equations by shape
         self.arrays: list[tuple[ArrayEquation, str, list[str] | None]] = []
         self.refused: str | None = None
         self.groups: list[tuple[list[Any], dict]] = []     # (components, arrays they read)
@@ -159,16 +160,37 @@ class _Equations:
     def _take(self, equations: list[Any], where: str) -> bool:
         """Add the equations of one component (False, with ``refused`` set, if they are not
         for the array path)."""
+        shapes = self.shapes
         for eq in equations:
             if isinstance(eq, ArrayEquation):
                 self.arrays.append((eq, where, None))
-            elif type(eq) is Equation and _block_operand(eq.lhs) and _block_operand(eq.rhs):
-                self.scalars.append((eq, where))
-            else:
+                self.items.append(eq)
+                continue
+            leaves: list[Any] = []
+            consts: list[float] = []
+            try:
+                if type(eq) is not Equation:
+                    raise TypeError(eq)
+                key = (_side_shape(eq.lhs, leaves, consts), _side_shape(eq.rhs, leaves, consts))
+                group = shapes.get(key)
+                if group is None:
+                    if not (_smooth(key[0]) and _smooth(key[1])):
+                        raise TypeError(key)
+                    group = shapes[key] = ScalarGroup(key)
+                    self.items.append(group)
+            except (TypeError, AttributeError):
                 self.refused = f"{where} has an equation that is not smooth arithmetic"
                 return False
-            self.items.append(eq)
+            group.leaves.append(leaves)
+            group.consts.append(consts)
+            group.equations.append(eq)
+            group.wheres.append(where)
         return True
+
+    def unit_groups(self) -> dict[Any, list]:
+        """The scalar equations as the unit check reads them (shape -> members)."""
+        return {key: list(zip(g.leaves, g.consts, g.wheres, g.equations, strict=True))
+                for key, g in self.shapes.items()}
 
 
 def _connectors_only(links: list[Connection]) -> bool:
@@ -177,10 +199,11 @@ def _connectors_only(links: list[Connection]) -> bool:
     return all(issubclass(t, Connector) for t in ends)
 
 
-def _scalar_groups(scalars: list[tuple[Equation, str]]) -> dict[Any, list]:
-    from ..passes.units import _scalar_groups as groups
-
-    return groups([eq for eq, _ in scalars], [where for _, where in scalars])
+def _smooth(shape: Any) -> bool:
+    """Whether an equation shape is made of leaves, constants and smooth operations."""
+    if isinstance(shape, str):
+        return True
+    return shape[0] in _SMOOTH_OPS and all(map(_smooth, shape[1:]))
 
 
 class _Columns:

@@ -28,6 +28,7 @@ class ScalarGroup:
     leaves: list[list[Any]] = field(default_factory=list)
     consts: list[list[float]] = field(default_factory=list)
     equations: list[Equation] = field(default_factory=list)
+    wheres: list[str] = field(default_factory=list)
 
     @property
     def shape(self) -> tuple[int]:
@@ -39,11 +40,11 @@ class ScalarGroup:
 
 def group_scalars(equations: list[Any]) -> list[Any]:
     """``equations`` with the scalar ones replaced by their :class:`ScalarGroup`, each at
-    the place of its first member."""
+    the place of its first member (groups made before are kept as they are)."""
     out: list[Any] = []
     groups: dict[Any, ScalarGroup] = {}
     for eq in equations:
-        if isinstance(eq, (ArrayEquation, LinearRows)):
+        if isinstance(eq, (ArrayEquation, LinearRows, ScalarGroup)):
             out.append(eq)
             continue
         leaves: list[Any] = []

@@ -4,7 +4,6 @@ variables and parameters.
 
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import Any
 
 from ...core.component import Element
@@ -256,7 +255,7 @@ def _override(decl: Any, m: Mod, info: ElemInfo, tref: TypeRef) -> Any:
                     raise fail(info.lex, comp, f"{comp.name}: {k} = {v!r} is not a number")
                 v = float(v)
             changes[f] = v
-    return replace(decl, **changes) if changes else decl
+    return decl.evolve(**changes) if changes else decl
 
 
 def apply_mods(elem: Element, mods: dict[str, Mod], info: ElemInfo, what: str) -> None:
@@ -299,7 +298,7 @@ def apply_mods(elem: Element, mods: dict[str, Mod], info: ElemInfo, what: str) -
                 raise fail(m.lex or info.lex, m.pos, f"{what}: {name} has unit "
                            f"{decl.unit!r}, not {attrs['unit']!r}")
             if changes:
-                sym.decl = replace(decl, **changes)
+                sym.decl = decl.evolve(**changes)
             continue
         child = elem._children.get(name)
         if child is not None:

@@ -22,6 +22,7 @@ from .env import Env, _category, _dims
 from .equations import _declaration_equations, equations_of
 from .evaluate import evaluate
 from .mods import Mod, _without_redeclare, index_mod, merge, mod_from_ast
+from .templates import EquationTemplate
 
 
 def _check_supported(view: ClassView, where: S.ClassScope) -> None:
@@ -225,14 +226,20 @@ def _make_class(view: ClassView, decls: dict[str, Any], connector: bool) -> type
     if not connector:
         eqs = view.equations
         ieqs = view.initial
+        template = EquationTemplate(view)        # shared by the instances of this class
 
         def equations(self):
             env = self.__dict__["_mo_env"]
             if env.cached is not None and env.cached[0] is not None:
                 out = env.cached[0]
                 env.cached = (None, env.cached[1])
-                return out
-            return equations_of(env, eqs)
+            else:
+                out = template.make(self)
+                if out is not None:
+                    return out
+                out = equations_of(env, eqs)
+            template.learn(self, out)
+            return out
 
         def initial_equations(self):
             env = self.__dict__["_mo_env"]
