@@ -10,6 +10,7 @@ propagation through element-wise operations would find it.
 
 from __future__ import annotations
 
+from itertools import chain
 from typing import Any
 
 import casadi as ca
@@ -80,9 +81,10 @@ class Lowered:
     def _group(self, group: ScalarGroup, start: int, rows: list, cols: list) -> None:
         """Scalar equations of one shape as one block on their leaves' columns."""
         size = len(group)
-        of = self.pos.of
-        idx = np.array([[of(sym) for sym in leaves] for leaves in group.leaves],
-                       dtype=np.int64).reshape(size, -1)
+        width = len(group.leaves[0])
+        flat = chain.from_iterable(group.leaves)
+        idx = np.fromiter(map(self.pos.__getitem__, map(id, flat)), np.int64,
+                          size * width).reshape(size, width)
         leaf_vecs = [self._take(idx[:, j]) for j in range(idx.shape[1])]
         const_vecs: list[Any] = []
         for j in range(len(group.consts[0])):

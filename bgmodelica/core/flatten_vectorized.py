@@ -143,7 +143,12 @@ def array_equations(items: list[Any],
     their class, over all of them), or None when they cannot be written that way.
     ``arrays``, if given, receives the arrays of the elements' scalars the equations read,
     by ``(connector name or None, declaration name)``."""
-    if len(items) < 2 or not _uniform(items):
+    if len(items) < 2:
+        return None
+    written_once = getattr(type(items[0]), "_group_equations", None)
+    if written_once is not None:          # a class from Modelica text (its own template)
+        return written_once(items, arrays)
+    if not _uniform(items):
         return None
     view = _View(items)
     out: list[ArrayEquation] = []

@@ -250,6 +250,7 @@ def _make_class(view: ClassView, decls: dict[str, Any], connector: bool) -> type
             return equations_of(env, ieqs, initial=True)
 
         body["equations"] = equations
+        body["_group_equations"] = staticmethod(template.group)
         if ieqs:
             body["initial_equations"] = initial_equations
     elif view.equations:

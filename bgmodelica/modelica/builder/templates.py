@@ -7,13 +7,20 @@ other calls) gives every instance the same expression trees but for the leaves. 
 instances' equations are evaluated from the syntax tree as usual; once a copy of the first
 instance's trees, with each leaf replaced by the second instance's own, equals the second's
 (the check), the others get such copies instead of an evaluation: a ladder of 1,000
-``Resistor`` instances is evaluated twice and copied 998 times.
+``Resistor`` instances is evaluated twice and copied 998 times. Flattening may also ask for
+the equations of many instances written once, as array equations over them (:meth:`group`),
+as it does for the components of a Python class.
 """
 
 from __future__ import annotations
 
+from operator import attrgetter
 from typing import Any
 
+import numpy as np
+
+from ...core.array_marks import mark_leaves
+from ...core.arrays import ArrayEquation, ArrayExpr, _lazy
 from ...core.expr import Equation, Leaf, Op
 from ...core.variables import TIME
 from .. import ast as A
@@ -24,6 +31,7 @@ _OPS = frozenset(("+", "-", "*", "/", "^"))
 _CALLS = frozenset(("der", "sin", "cos", "tan", "asin", "acos", "atan", "sinh", "cosh", "tanh",
                     "exp", "log", "sqrt", "abs"))
 _PLACES = (int, float)
+_EQUATIONS = attrgetter("_equations")
 
 
 class EquationTemplate:
@@ -51,6 +59,47 @@ class EquationTemplate:
                 self.state = "learning"
         elif self.state == "learning":
             self.state = "ready" if _same(self._copy(inst), out) else "off"
+
+    def group(self, items: list[Any], arrays: dict | None = None) -> list[Any] | None:
+        """The equations of the instances ``items`` (of this class) written once, as array
+        equations over them (see :func:`~bgmodelica.core.flatten_vectorized.array_equations`,
+        which asks); None when the class's equations are not plain or an instance has
+        equations of its own (declaration equations)."""
+        for inst in items[:2]:
+            if self.state in ("new", "learning"):
+                inst.equations()                      # evaluates, and learns
+        if self.state != "ready" or any(map(_EQUATIONS, items)):
+            return None
+        columns: dict[int, ArrayExpr] = {}
+        try:
+            for key, (sub, name, is_der) in self.places.items():
+                holders = items if sub is None else [inst._children[sub] for inst in items]
+                symbols = [h._symbols[name] for h in holders]
+                if is_der:
+                    symbols = [sym.derivative() for sym in symbols]
+                leaves = np.empty(len(items), dtype=object)
+                leaves[:] = [sym.leaf for sym in symbols]
+                decls = [sym.decl for sym in symbols]
+                mark_leaves(leaves, len({type(d) for d in decls}) == 1
+                            and len({d.unit for d in decls}) == 1)
+                columns[key] = ArrayExpr(leaves)
+                if arrays is not None and not is_der:
+                    arrays[(sub, name)] = columns[key]
+        except (KeyError, AttributeError):
+            return None
+
+        def copy(e: Any) -> Any:
+            kind = type(e)
+            if kind is Leaf:
+                return columns.get(id(e.sym), e)
+            if kind is Op:
+                return _lazy(e.op, *map(copy, e.args))
+            return float(e)
+
+        out = [ArrayEquation(copy(eq.lhs), copy(eq.rhs)) for eq in self.trees]
+        if not all(eq.shape == (len(items),) and eq.is_block() for eq in out):
+            return None
+        return out
 
     def _keep(self, inst: Any, out: list[Any]) -> bool:
         """Keep ``out`` as the trees to copy, with the place of each leaf in ``inst``."""
