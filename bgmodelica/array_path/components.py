@@ -17,7 +17,7 @@ level, initial equations, events) goes the scalar way.
 
 from __future__ import annotations
 
-from itertools import chain, repeat
+from itertools import repeat
 from operator import add, attrgetter, is_not, itemgetter, methodcaller
 from typing import Any
 
@@ -495,6 +495,8 @@ def _connections(links: list[Connection], cols: _Columns) -> list[Any] | str:
         return "a connection uses a connector that is not part of the model"
     if (heads == tails).any():
         return "a connector is connected to itself"
+    if n_c == 0:
+        return []
     nodes, cuts = connection_set_arrays(n_c, 2 * heads, 2 * tails, cols.paths)
     starts = np.concatenate(([0], cuts)).astype(np.int64)
     set_of = np.repeat(np.arange(starts.size), np.diff(np.concatenate((starts, [nodes.size]))))
@@ -510,4 +512,4 @@ def _connections(links: list[Connection], cols: _Columns) -> list[Any] | str:
         sizes = np.diff(np.concatenate((starts, [nodes.size])))[mine]
         sub_cuts = np.cumsum(sizes)[:-1]
         out.extend(set_rows(nodes[keep], sub_cuts, cols.columns[:, :len(keys)], flows))
-    return list(chain(out))
+    return out

@@ -675,3 +675,30 @@ def test_fmu_export_of_a_model_of_components_from_the_array_path(tmp_path):
     tau = _branch_r(2, n) * _branch_c(2, n)
     assert abs(out["C2.v"][-1] - volts * (1 - np.exp(-1.0 / tau))) < 1e-4
     assert abs(out["R2.i"][-1] - volts / _branch_r(2, n) * np.exp(-1.0 / tau)) < 1e-4
+
+
+class Decay(Component):
+    """``der(x) = -k*x``, ``x(0) = 1``: no connectors."""
+
+    x = Variable(start=1.0, fixed=True)
+    k = Parameter(1.0)
+
+    def equations(self):
+        yield der(self.x) == -self.k * self.x
+
+
+class Decays(Component):
+    """``n`` independent :class:`Decay` components (``k = 1 + i/10``), no connections."""
+
+    def __init__(self, n: int = 3, **modifiers):
+        super().__init__(**modifiers)
+        for i in range(n):
+            self.add(f"d{i}", Decay(k=1.0 + i / 10))
+
+
+@pytest.mark.parametrize("n", [3, 100])
+def test_components_without_connectors_take_the_array_path(n):
+    fast, slow = _fast_and_slow(lambda: Decays(n))
+    _same_dae(fast.dae, slow.dae)
+    res = bg.simulate(fast, stop_time=1.0, interval=0.5, outputs=[f"d{n - 1}.x"], **TIGHT)
+    assert abs(res.final(f"d{n - 1}.x") - np.exp(-(1.0 + (n - 1) / 10))) < 1e-8
