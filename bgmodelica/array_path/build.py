@@ -35,6 +35,7 @@ def solve_blocks(low: Lowered, order: ExplicitOrder, unknown: np.ndarray) -> ca.
     n = low.n
     starts = np.concatenate([[0], np.cumsum(low.sizes)]).astype(np.int64)
     current = low.x
+    coefficients: list[ca.MX] = []
     for b, rows in order.steps():
         r = low.blocks[b]
         here = np.arange(starts[b], starts[b + 1]) if rows is None else starts[b] + rows
@@ -47,13 +48,30 @@ def solve_blocks(low: Lowered, order: ExplicitOrder, unknown: np.ndarray) -> ca.
             return f"block {b}: an unknown's coefficient is structurally zero"
         if ca.jtimes(coefficient, low.x, seed).nnz():
             return f"block {b}: not linear in its unknowns"
+        coefficients.append(coefficient)
         # -r/coefficient with the block's own unknowns read as 0: they still are symbols
         # of x here, which :func:`assemble` evaluates with structural zeros in place of
         # every unknown, so their terms drop out exactly
         solution = ca.substitute(-r / coefficient, low.x, current)
         current = ca.MX(current)
         current[mine.tolist()] = solution
+    if _cancelled(low, coefficients):
+        return "an unknown's terms cancel in the equation solving it (a singular system)"
     return current
+
+
+def _cancelled(low: Lowered, coefficients: list[ca.MX]) -> bool:
+    """Whether a coefficient is zero at a random point: its terms cancel (``p.v - n.v`` of a
+    part with both pins on one node, once they are one variable), which the incidence, made
+    of the operands' columns, does not show. A zero at a random point is a zero everywhere
+    (with probability one), and the scalar pipeline, which sees the cancellation, decides."""
+    if not coefficients:
+        return False
+    rng = np.random.default_rng(7)
+    values = ca.Function("coefficients", [low.x, low.p, low.t], coefficients)(
+        rng.uniform(0.5, 1.5, low.n), rng.uniform(0.5, 1.5, low.n_p), rng.uniform(0.5, 1.5))
+    values = values if isinstance(values, (list, tuple)) else [values]
+    return any(bool((np.asarray(v) == 0).any()) for v in values)
 
 
 def _column(n: int, rows: np.ndarray) -> ca.Sparsity:
