@@ -35,7 +35,11 @@ def solve_blocks(low: Lowered, order: ExplicitOrder, unknown: np.ndarray) -> ca.
     n = low.n
     starts = np.concatenate([[0], np.cumsum(low.sizes)]).astype(np.int64)
     current = low.x
-    coefficients: list[ca.MX] = []
+    coefficients: list[ca.MX] = []        # those that might cancel (see _cancelled)
+    pairs = low.rows * (low.n + low.n_p + 1) + low.cols
+    values, counts = np.unique(pairs, return_counts=True)
+    twice = np.zeros(int(starts[-1]), dtype=bool)      # rows using a column twice
+    twice[values[counts > 1] // (low.n + low.n_p + 1)] = True
     for b, rows in order.steps():
         r = low.blocks[b]
         here = np.arange(starts[b], starts[b + 1]) if rows is None else starts[b] + rows
@@ -48,7 +52,8 @@ def solve_blocks(low: Lowered, order: ExplicitOrder, unknown: np.ndarray) -> ca.
             return f"block {b}: an unknown's coefficient is structurally zero"
         if ca.jtimes(coefficient, low.x, seed).nnz():
             return f"block {b}: not linear in its unknowns"
-        coefficients.append(coefficient)
+        if twice[here].any():
+            coefficients.append(coefficient)
         # -r/coefficient with the block's own unknowns read as 0: they still are symbols
         # of x here, which :func:`assemble` evaluates with structural zeros in place of
         # every unknown, so their terms drop out exactly
@@ -63,7 +68,8 @@ def solve_blocks(low: Lowered, order: ExplicitOrder, unknown: np.ndarray) -> ca.
 def _cancelled(low: Lowered, coefficients: list[ca.MX]) -> bool:
     """Whether a coefficient is zero at a random point: its terms cancel (``p.v - n.v`` of a
     part with both pins on one node, once they are one variable), which the incidence, made
-    of the operands' columns, does not show. A zero at a random point is a zero everywhere
+    of the operands' columns, does not show. Only rows using a column twice can cancel so;
+    their blocks' coefficients are checked. A zero at a random point is a zero everywhere
     (with probability one), and the scalar pipeline, which sees the cancellation, decides."""
     if not coefficients:
         return False

@@ -83,8 +83,8 @@ class Lowered:
         size = len(group)
         width = len(group.leaves[0])
         flat = chain.from_iterable(group.leaves)
-        idx = np.fromiter(map(self.pos.__getitem__, map(id, flat)), np.int64,
-                          size * width).reshape(size, width)
+        idx = np.fromiter(map(self.pos.of, flat), np.int64,      # (of: without filling the
+                          size * width).reshape(size, width)      # dict of a leaf model)
         leaf_vecs = [self._take(idx[:, j]) for j in range(idx.shape[1])]
         const_vecs: list[Any] = []
         for j in range(len(group.consts[0])):
