@@ -380,7 +380,7 @@ def table(report: dict) -> str:
     lines = ["| benchmark | bgmodelica | baseline (same run) | ratio | target |",
              "|---|---:|---:|---:|---|"]
     for r in report["rc_ladder"]:
-        lines.append(f"| RC ladder n = {r['n']:,}, build + 10-s solve | "
+        lines.append(f"| RC ladder, component per section, n = {r['n']:,}, build + 10-s solve | "
                      f"{r['bgmodelica_total']:.3f} s | CasADi/CVODES by hand "
                      f"{r['casadi_cvodes_total']:.3f} s | {r['ratio_vs_casadi']:.2f}x | "
                      f"{'<= 2.5x' if r['n'] == 10000 else ('< 0.5 s' if r['n'] == 1000 else '')}"
