@@ -6,9 +6,10 @@ by ``connect`` statements. Such a model is collected without a Python object per
 
 - the equations of many components of one class are written once for all of them
   (:func:`~bgmodelica.core.flatten_vectorized.array_equations`, as the scalar pipeline
-  groups them), the others are asked one by one;
+  groups them), the others are asked one by one and their scalar equations grouped by shape
+  (:mod:`.scalars`);
 - the columns follow the scalar pipeline's order (the tree, each variable followed by its
-  derivative), computed per class and per declaration with numpy;
+  derivative), computed per class and per declaration with numpy (:mod:`.columns`);
 - the connection sets become linear rows (:mod:`.connections`).
 
 Anything else (subcomponents with subcomponents, signal connections, connectors of the top
