@@ -16,7 +16,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from ..core.arrays import ArrayEquation, ArrayExpr
+from ..core.arrays import ArrayExpr
 from ..core.expr import Expr, apply_op, lower_group, lower_tree
 from ..core.flatten import _count
 from ..core.flatten_arrays import _rows
@@ -50,23 +50,26 @@ class Lowered:
                 self._group(eq, start, rows, cols)
                 start += len(eq)
                 continue
-            shape = eq.shape if isinstance(eq, ArrayEquation) else ()
+            shape = eq.shape                   # an array equation (scalar ones are grouped)
             size = int(np.prod(shape))
             left, lmaps = self.lower(eq.lhs, shape)
             right, rmaps = self.lower(eq.rhs, shape)
-            res = left - right
-            if not isinstance(res, ca.MX):
-                res = ca.MX(res)
-            if res.numel() != size:
-                res = ca.repmat(res, size, 1)
-            self.blocks.append(res)
-            self.sizes.append(size)
+            self._add(left - right, size)
             for m in (*lmaps, *rmaps):
                 rows.append(np.arange(start, start + size, dtype=np.int64))
                 cols.append(np.broadcast_to(m, (size,)))
             start += size
         self.rows = np.concatenate(rows) if rows else np.zeros(0, dtype=np.int64)
         self.cols = np.concatenate(cols) if cols else np.zeros(0, dtype=np.int64)
+
+    def _add(self, res: Any, size: int) -> None:
+        """A block: the residual ``res`` as an MX column of ``size`` rows."""
+        if not isinstance(res, ca.MX):
+            res = ca.MX(res)
+        if res.numel() != size:
+            res = ca.repmat(res, size, 1)
+        self.blocks.append(res)
+        self.sizes.append(size)
 
     def _linear(self, eq: LinearRows, start: int, rows: list, cols: list) -> None:
         """Linear rows (connection sets) as one sparse matrix product."""
@@ -92,14 +95,8 @@ class Lowered:
             const_vecs.append(values[0] if values.count(values[0]) == size else ca.DM(values))
         shape_l, shape_r = group.key
         n_l, c_l = _count(shape_l, "L"), _count(shape_l, "C")
-        res = lower_group(shape_l, leaf_vecs[:n_l], const_vecs[:c_l]) \
-            - lower_group(shape_r, leaf_vecs[n_l:], const_vecs[c_l:])
-        if not isinstance(res, ca.MX):
-            res = ca.MX(res)
-        if res.numel() != size:
-            res = ca.repmat(res, size, 1)
-        self.blocks.append(res)
-        self.sizes.append(size)
+        self._add(lower_group(shape_l, leaf_vecs[:n_l], const_vecs[:c_l])
+                  - lower_group(shape_r, leaf_vecs[n_l:], const_vecs[c_l:]), size)
         rows.append(np.repeat(np.arange(start, start + size, dtype=np.int64), idx.shape[1]))
         cols.append(idx.ravel())
 
