@@ -120,8 +120,8 @@ class Element:
             child = _build_child(key, template)
             if local and key in local:
                 child.modify(**_as_modifiers(key, local.pop(key)))
-            if isinstance(child, ComponentArray):
-                self.add(key, child)
+            if isinstance(child, ComponentArray) or key in symbols:
+                self.add(key, child)               # (a name taken twice: _add says so)
             else:                                  # self._add, less the checks a class passed
                 object.__setattr__(child, "_name", key)
                 children[key] = child

@@ -503,3 +503,17 @@ def test_large_floating_network_is_named():
         bg.compile(m)
     assert str(err.value).startswith("connection set {C1.n, ")
     assert f"... ({n + 1} connectors)}} has no reference (ground)" in str(err.value)
+
+
+def test_a_subclass_declaring_a_connector_under_a_variable_name_is_refused():
+    from bgmodelica.errors import DuplicateNameError
+    from library.electrical import Pin
+
+    class Base(bg.Component):
+        p = bg.Variable()
+
+    class Sub(Base):
+        p = Pin()
+
+    with pytest.raises(DuplicateNameError, match="'p' already exists"):
+        Sub()
