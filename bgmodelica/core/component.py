@@ -42,6 +42,7 @@ from .arrays import (
     element_values,
     normalize_shape,
 )
+from .children import build_child
 from .expr import Expr, Leaf
 from .variables import (
     KIND_FLOW,
@@ -117,7 +118,7 @@ class Element:
             attrs[key] = sym.leaf
         children = attrs["_children"]
         for key, template in type(self)._templates.items():
-            child = _build_child(key, template)
+            child = build_child(key, template)
             if local and key in local:
                 child.modify(**_as_modifiers(key, local.pop(key)))
             if isinstance(child, ComponentArray) or key in symbols:
@@ -272,58 +273,6 @@ class Element:
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self._name or ''})"
-
-
-def _build_child(key: str, template: Element) -> Element:
-    """``template.clone()``; an exception of user code names the subcomponent path."""
-    if _plain_connector(type(template)) and template._init_call == _NO_CALL:
-        return _fresh_connector(type(template))
-    try:
-        return template.clone()
-    except Exception as err:  # noqa: BLE001 -- user code: say where, no traceback
-        from ..errors import ModelError, UserCodeError
-        from ..validate import nested_user_error, user_error
-
-        if isinstance(err, UserCodeError):
-            raise nested_user_error(err, key, type(template).__name__) from err.__cause__
-        if isinstance(err, ModelError):
-            raise
-        raise nested_user_error(user_error(err, f"{type(template).__name__}()"), key,
-                                type(template).__name__) from err
-
-
-_NO_CALL: tuple[tuple, dict] = ((), {})
-_PLAIN_CONNECTORS: dict[type, bool] = {}
-
-
-def _plain_connector(cls: type) -> bool:
-    """Whether ``cls()`` is a connector built by :class:`Element`'s constructor alone, of
-    scalar declarations and no subconnectors (then :func:`_fresh_connector` makes it)."""
-    found = _PLAIN_CONNECTORS.get(cls)
-    if found is None:
-        found = _PLAIN_CONNECTORS[cls] = (
-            issubclass(cls, Connector) and cls.__init__ is Element.__init__
-            and cls.__new__ is Element.__new__ and not cls._templates
-            and all(d.shape == () for d in cls._declarations.values()))
-    return found
-
-
-def _fresh_connector(cls: type) -> Element:
-    """``cls()`` for a plain connector class (:func:`_plain_connector`), without the
-    constructor's general machinery: a component's connectors are built by the thousand."""
-    self = object.__new__(cls)
-    attrs = self.__dict__
-    attrs["_init_call"] = _NO_CALL
-    attrs["_name"] = None
-    symbols: dict[str, Symbol] = {}
-    attrs["_symbols"] = symbols
-    attrs["_children"] = {}
-    attrs["_equations"] = []
-    for key, decl in cls._declarations.items():
-        sym = Symbol(key, decl, self)
-        symbols[key] = sym
-        attrs[key] = sym.leaf
-    return self
 
 
 def _as_modifiers(name: str, value: Any) -> dict[str, Any]:
