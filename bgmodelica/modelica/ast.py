@@ -180,6 +180,85 @@ class EqWhen:
     pos: Pos = (0, 0)
 
 
+@dataclass(slots=True)
+class TupleExpr:
+    """The left side ``(a, , b)`` of a tuple equation or assignment (None for an omitted
+    output)."""
+
+    items: tuple
+    pos: Pos = (0, 0)
+
+
+# -- algorithms ----------------------------------------------------------------------------------
+
+
+@dataclass(slots=True)
+class Assign:
+    """``target := value``; ``target`` a :class:`Ref` or a :class:`TupleExpr` of them."""
+
+    target: Any
+    value: Any
+    pos: Pos = (0, 0)
+
+
+@dataclass(slots=True)
+class StmtCall:
+    """A call statement: ``assert(...)``, ``terminate(...)``, ``reinit(...)``, ``f(...)``."""
+
+    call: Call
+    pos: Pos = (0, 0)
+
+
+@dataclass(slots=True)
+class StmtIf:
+    branches: tuple[tuple[Any, tuple], ...]     # (condition, statements)
+    otherwise: tuple
+    pos: Pos = (0, 0)
+
+
+@dataclass(slots=True)
+class StmtFor:
+    indices: tuple[tuple[str, Any], ...]        # (name, range expression or None)
+    body: tuple
+    pos: Pos = (0, 0)
+
+
+@dataclass(slots=True)
+class StmtWhile:
+    condition: Any
+    body: tuple
+    pos: Pos = (0, 0)
+
+
+@dataclass(slots=True)
+class StmtWhen:
+    branches: tuple[tuple[Any, tuple], ...]     # (condition, statements); elsewhen follow
+    pos: Pos = (0, 0)
+
+
+@dataclass(slots=True)
+class Return:
+    pos: Pos = (0, 0)
+
+
+@dataclass(slots=True)
+class Break:
+    pos: Pos = (0, 0)
+
+
+@dataclass(slots=True)
+class External:
+    """``external "C" out = fname(args) annotation(...)``; ``function`` None when the clause
+    names no call (the default: the Modelica name, inputs then outputs)."""
+
+    language: str = "C"
+    output: Any = None                          # Ref or None
+    function: str | None = None
+    args: tuple = ()
+    annotation: Modification | None = None
+    pos: Pos = (0, 0)
+
+
 # -- declarations --------------------------------------------------------------------------------
 
 
@@ -241,6 +320,13 @@ class ClassDef:
     parent: ClassDef | None = None
     file: str = ""
     element_prefixes: frozenset[str] = frozenset()
+    algorithms: list = field(default_factory=list)          # one tuple of statements a section
+    initial_algorithms: list = field(default_factory=list)
+    external: External | None = None
+    purity: str = ""              # "pure" / "impure" / ""
+    encapsulated: bool = False
+    protected: frozenset[str] = frozenset()   # names of the elements declared protected
+    directory: str = ""           # a package stored as a folder: its path (library loading)
 
     @property
     def full_name(self) -> str:
