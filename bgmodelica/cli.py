@@ -262,15 +262,21 @@ class _Parser(argparse.ArgumentParser):
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="bgmodelica",
-        description="Equation-based modeling with bond graphs: simulate, check, export.")
+        description="Equation-based modeling with bond graphs: simulate, check, export.",
+        epilog="MODEL is path/file.py:Name, package.module:Name, file.mo:Package.Model or a "
+               "Modelica class on the library path (Modelica.Blocks.Examples.PID_Controller). "
+               "The library path is MODELICAPATH plus --modelica-path DIR (repeatable, any "
+               "command).")
     from . import __version__
 
     parser.add_argument("--version", action="version", version=f"bgmodelica {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
     def model_args(p: argparse.ArgumentParser) -> None:
-        p.add_argument("model", help="path/file.py:Name, package.module:Name or "
-                                     "file.mo:Package.Model (Modelica text)")
+        p.add_argument("model", help="path/file.py:Name, package.module:Name, "
+                                     "file.mo:Package.Model (Modelica text) or a Modelica "
+                                     "class on the library path (MODELICAPATH, "
+                                     "--modelica-path DIR)")
         p.add_argument("--arg", action="append", default=[], metavar="NAME=VALUE",
                        help="argument for a parameterized model constructor (e.g. n=100)")
 
@@ -395,6 +401,32 @@ def _error_line(err: BaseException) -> str:
     return f"error: {type(err).__name__}: {one_line(str(err))}"
 
 
+def _modelica_path_options(argv: list[str]) -> list[str]:
+    """Take ``--modelica-path DIR`` (any number, anywhere on the line) out of ``argv`` and
+    put the folders on the Modelica library path."""
+    from .modelica.library_path import add_modelica_path
+
+    rest: list[str] = []
+    folders: list[str] = []
+    k = 0
+    while k < len(argv):
+        a = argv[k]
+        if a == "--modelica-path":
+            if k + 1 >= len(argv):
+                raise ModelError("--modelica-path needs a folder")
+            folders.append(argv[k + 1])
+            k += 2
+            continue
+        if a.startswith("--modelica-path="):
+            folders.append(a.partition("=")[2])
+        else:
+            rest.append(a)
+        k += 1
+    if folders:
+        add_modelica_path(*folders)
+    return rest
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     global _TERMINAL
     import contextlib
@@ -402,6 +434,11 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     parser = build_parser()
     _autocomplete(parser)
+    try:
+        argv = _modelica_path_options(list(sys.argv[1:] if argv is None else argv))
+    except ModelError as err:
+        print(_error_line(err), file=sys.stderr)
+        return 2
     try:
         args = parser.parse_args(argv)
     except SystemExit as done:            # usage error (one line) or --help

@@ -22,7 +22,7 @@ from typing import Any
 def experiment_of_reference(ref: str) -> dict[str, float]:
     """The experiment annotation of ``file.mo:Package.Model`` without building the model
     ({} when the reference is not Modelica or cannot be read: loading reports that)."""
-    from . import is_reference
+    from . import is_library_class, is_reference
 
     if not is_reference(ref):
         return {}
@@ -31,6 +31,11 @@ def experiment_of_reference(ref: str) -> dict[str, float]:
         from .parser import parse_file
         from .scope import FileScope
 
+        if is_library_class(ref):
+            from .library_path import resolve
+
+            scope = resolve(ref)
+            return experiment(scope) if scope is not None else {}
         if ref.lower().endswith(".mo"):
             path, name = ref, None
         else:

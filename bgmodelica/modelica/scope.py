@@ -161,7 +161,13 @@ class ClassScope:
             return hit
         cdef = self._classes.get(name)
         if cdef is None:
-            return None
+            if not self.cdef.directory:
+                return None
+            from .library_path import child_class
+            scope = child_class(self, name)
+            if scope is not None:
+                self._cache[name] = scope
+            return scope
         scope = ClassScope(cdef, self, self.file)
         self._cache[name] = scope
         return scope
@@ -226,6 +232,10 @@ def lookup_top(file: FileScope, name: str) -> Any:
             return hit
     if name in BUILTINS:
         return BUILTINS[name]
+    from .library_path import top_package
+    hit = top_package(name)
+    if hit is not None:
+        return hit
     if name == "Modelica":
         from . import msl
         return msl.resolve("Modelica")

@@ -34,9 +34,6 @@ CASES = [
      "unknown name 'q'"),
     ("model M\n  Real v;\n  Real x[v];\nequation\n  v = 1;\nend M;\n", 3, 8,
      "array size of x must be known when the model is built"),
-    ("function f\n  input Real u;\n  output Real y;\nalgorithm\n  y := u;\nend f;\n"
-     "model M\n  Real x;\nequation\n  x = f(time);\nend M;\n", 10, 7,
-     "user-defined function f()"),
     ("model M\n  Real x(foo = 1);\nequation\n  x = 1;\nend M;\n", 2, 10,
      "'foo' is not an attribute"),
     ("model M\n  Real x;\nequation\n  for i in 1:2 loop\n    x = i;\n  end for;\n"

@@ -19,19 +19,35 @@ from .evaluate import _comprehension, evaluate
 
 
 def _ev_call(node: A.Call, ctx: Ctx) -> Any:
-    fname = _function_name(node, ctx)
-    handler = _FUNCTIONS.get(fname)
+    target = _function_target(node, ctx)
+    if isinstance(target, S.ClassScope):
+        from .algorithms import call_function
+
+        return call_function(target, node, ctx)
+    handler = _FUNCTIONS.get(target)
     if handler is None:
         raise fail(ctx.lex, node, f"{node.func.dotted}() is not supported here")
     return handler(node, ctx)
 
 
-def _function_name(node: A.Call, ctx: Ctx) -> str:
+def resolve_function(node: A.Call, ctx: Ctx) -> S.ClassScope | None:
+    """The Modelica function class a call names (None for a built-in function)."""
+    target = _function_target(node, ctx)
+    return target if isinstance(target, S.ClassScope) else None
+
+
+def _function_target(node: A.Call, ctx: Ctx) -> Any:
+    """A built-in function's name, or the ClassScope of a Modelica function."""
     ref = node.func
     parts = [p for p, _ in ref.parts]
     if len(parts) == 1:
         name = parts[0]
-        found = S.lookup(ctx.lex, name) if ctx.lex is not None else None
+        if ref.global_:
+            if name in _FUNCTIONS:
+                return name
+            found = S.lookup_top(ctx.lex.file, name) if ctx.lex is not None else None
+        else:
+            found = S.lookup(ctx.lex, name) if ctx.lex is not None else None
         if found is None or isinstance(found, S.Builtin):
             if name in _FUNCTIONS:
                 return name
@@ -39,7 +55,10 @@ def _function_name(node: A.Call, ctx: Ctx) -> str:
         if isinstance(found, S.ClassScope):
             return _user_function(found, node, ctx)
         raise fail(ctx.lex, node, f"{name} is not a function")
-    found = S.lookup(ctx.lex, parts[0]) if ctx.lex is not None else None
+    if ref.global_ and ctx.lex is not None:
+        found = S.lookup_top(ctx.lex.file, parts[0])
+    else:
+        found = S.lookup(ctx.lex, parts[0]) if ctx.lex is not None else None
     got = S.walk(found, parts[1:]) if found is not None else None
     if isinstance(got, tuple) and got and got[0] == "function":
         return got[1]
@@ -48,11 +67,16 @@ def _function_name(node: A.Call, ctx: Ctx) -> str:
     raise fail(ctx.lex, node, f"unknown function {ref.dotted}()")
 
 
-def _user_function(found: S.ClassScope, node: A.Call, ctx: Ctx) -> str:
+def _user_function(found: S.ClassScope, node: A.Call, ctx: Ctx) -> Any:
     kind = found.cdef.kind
-    if kind == "function":
-        raise fail(ctx.lex, node, f"unsupported Modelica construct: call of the user-defined "
-                   f"function {found.full_name}() (only the built-in functions are supported)")
+    if kind.endswith("function"):
+        return found
+    if found.cdef.short is not None and found.cdef.enum is None:
+        from .classes import resolve_class
+
+        base = resolve_class(found.parent, found.cdef.short[1], found.cdef.pos, found)
+        if isinstance(base, S.ClassScope) and base.cdef.kind.endswith("function"):
+            return found
     if kind == "record":
         raise fail(ctx.lex, node, f"unsupported Modelica construct: record constructor "
                    f"{found.full_name}()")
@@ -60,6 +84,9 @@ def _user_function(found: S.ClassScope, node: A.Call, ctx: Ctx) -> str:
         name = found.cdef.name
         if name in ("Real", "Integer"):
             return name
+    ctor = found.nested("constructor")
+    if ctor is not None and ctor.cdef.kind.endswith("function"):
+        return ctor                          # an ExternalObject: its constructor
     raise fail(ctx.lex, node, f"{found.full_name} is a {kind}, not a function")
 
 

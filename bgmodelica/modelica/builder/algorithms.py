@@ -1,0 +1,479 @@
+"""Modelica functions (specification chapter 12) evaluated by executing their algorithm.
+
+A call binds the inputs (positional, named, defaults evaluated in the function's scope),
+gives outputs and protected variables their bindings, then runs the statements on values:
+numbers, strings, lists for arrays, and symbolic expressions for time-varying arguments.
+With symbolic values the call is inlined: an ``if`` whose condition is symbolic runs both
+branches and merges the assigned variables with ``if_else``; ``for`` ranges and ``while``
+conditions must be known numbers (a loop over a time-varying bound is refused). Functions
+with an ``external`` clause call the native re-implementation registered under the clause's
+C name (:mod:`bgmodelica.modelica.externals`).
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+from ...core.expr import Expr
+from .. import ast as A
+from .. import scope as S
+from .arith import _if_else
+from .base import Ctx, NotConstant, fail, numeric_value
+
+#: statements run per call before a loop is taken for endless
+MAX_STEPS = 2_000_000
+
+
+class _Return(Exception):
+    pass
+
+
+class _Break(Exception):
+    pass
+
+
+class FunctionDef:
+    """A function class with its ``extends`` merged: inputs, outputs, protected variables
+    (declaration order) and the algorithm or external clause."""
+
+    __slots__ = ("scope", "inputs", "outputs", "locals", "algorithms", "external", "name")
+
+    def __init__(self, scope: S.ClassScope) -> None:
+        from .classes import class_view
+
+        view = class_view(scope)
+        self.scope = scope
+        self.name = scope.full_name
+        self.inputs: list[tuple[A.Component, S.ClassScope]] = []
+        self.outputs: list[tuple[A.Component, S.ClassScope]] = []
+        self.locals: list[tuple[A.Component, S.ClassScope]] = []
+        for info in view.elements.values():
+            comp = info.comp
+            entry = (comp, info.lex, info)
+            if "input" in comp.prefixes:
+                self.inputs.append(entry)
+            elif "output" in comp.prefixes:
+                self.outputs.append(entry)
+            else:
+                self.locals.append(entry)
+        self.algorithms: list[tuple[tuple, S.ClassScope]] = []
+        self.external: tuple[A.External, S.ClassScope] | None = None
+        for s in _bases(scope):
+            for section in s.cdef.algorithms:
+                self.algorithms.append((section, s))
+            if s.cdef.external is not None and self.external is None:
+                self.external = (s.cdef.external, s)
+
+
+def _bases(scope: S.ClassScope) -> list[S.ClassScope]:
+    """``scope`` and the classes it extends, bases first."""
+    from .classes import resolve_class
+
+    out: list[S.ClassScope] = []
+    for el in scope.cdef.elements:
+        if isinstance(el, A.Extends):
+            base = resolve_class(scope, el.type_name, el.pos, scope, extends=True)
+            if isinstance(base, S.ClassScope):
+                out.extend(_bases(base))
+    if scope.cdef.short is not None:
+        base = resolve_class(scope.parent, scope.cdef.short[1], scope.cdef.pos, scope)
+        if isinstance(base, S.ClassScope):
+            out.extend(_bases(base))
+    out.append(scope)
+    return out
+
+
+_DEFS: dict[int, FunctionDef] = {}
+
+
+def function_def(scope: S.ClassScope) -> FunctionDef:
+    hit = _DEFS.get(id(scope.cdef))
+    if hit is None or hit.scope.cdef is not scope.cdef:
+        hit = FunctionDef(scope)
+        _DEFS[id(scope.cdef)] = hit
+    return hit
+
+
+def call_function(scope: S.ClassScope, node: A.Call, ctx: Ctx) -> Any:
+    """The value of the call ``node`` of function ``scope`` (a tuple for several outputs
+    when the caller asks for them through a tuple target; else the first output)."""
+    from .evaluate import evaluate
+
+    args = [evaluate(a, ctx) for a in node.args]
+    kwargs = {k: evaluate(v, ctx) for k, v in node.kwargs.items()}
+    return apply_function(scope, args, kwargs, ctx, node)
+
+
+def apply_function(scope: S.ClassScope, args: list, kwargs: dict, ctx: Ctx, node: Any,
+                   all_outputs: bool = False) -> Any:
+    """Run function ``scope`` on evaluated arguments."""
+    fn = function_def(scope)
+    if len(args) > len(fn.inputs):
+        raise fail(ctx.lex, node, f"{fn.name}() takes {len(fn.inputs)} input(s), got "
+                   f"{len(args)}")
+    local: dict[str, Any] = {}
+    names = [c.name for c, _, _ in fn.inputs]
+    for name in kwargs:
+        if name not in names:
+            raise fail(ctx.lex, node, f"{fn.name}() has no input {name!r}; it has: "
+                       f"{', '.join(names) or 'none'}")
+    for k, (comp, lex, info) in enumerate(fn.inputs):
+        if k < len(args):
+            local[comp.name] = args[k]
+            if comp.name in kwargs:
+                raise fail(ctx.lex, node, f"{fn.name}(): input {comp.name} given twice")
+        elif comp.name in kwargs:
+            local[comp.name] = kwargs[comp.name]
+    for comp, lex, info in fn.inputs:
+        if comp.name not in local:
+            binding = _binding(info)
+            if binding is None:
+                raise fail(ctx.lex, node, f"{fn.name}(): input {comp.name} has no value and "
+                           "no default")
+            local[comp.name] = _ev(binding, lex, local, info)
+    for comp, lex, info in fn.outputs + fn.locals:
+        if comp.name in local:
+            continue
+        binding = _binding(info)
+        if binding is not None:
+            local[comp.name] = _ev(binding, lex, local, info)
+        else:
+            local[comp.name] = _initial(comp, lex, local, info)
+    if fn.external is not None and not fn.algorithms:
+        _external(fn, local, ctx, node)
+    else:
+        state = _State()
+        try:
+            for section, lex in fn.algorithms:
+                _run(section, Ctx(None, lex, local, False), state)
+        except _Return:
+            pass
+        except _Break:
+            raise fail(fn.scope, node, "break outside a loop") from None
+        except RecursionError:
+            raise fail(ctx.lex, node, f"{fn.name}(): recursion too deep") from None
+    outs = [local.get(c.name) for c, _, _ in fn.outputs]
+    for (c, _, _), v in zip(fn.outputs, outs, strict=True):
+        if v is None:
+            raise fail(ctx.lex, node, f"{fn.name}(): output {c.name} is never assigned")
+    if all_outputs:
+        return tuple(outs)
+    if not outs:
+        return None
+    return outs[0]
+
+
+def _binding(info: Any) -> Any:
+    m = info.mod
+    if m is not None and m.has_binding:
+        return m.binding
+    mod = info.comp.mod
+    return mod.binding if mod is not None else None
+
+
+def _ev(expr: Any, lex: S.ClassScope, local: dict, info: Any) -> Any:
+    from .evaluate import evaluate
+
+    return evaluate(expr, Ctx(None, lex, local, False))
+
+
+def _initial(comp: A.Component, lex: S.ClassScope, local: dict, info: Any) -> Any:
+    """An unbound output or protected variable: zeros of its declared size (sizes ``:`` are
+    fixed by the first assignment)."""
+    from .evaluate import evaluate
+
+    dims = []
+    for d in comp.dims:
+        if isinstance(d, A.Colon):
+            return None
+        v = numeric_value(evaluate(d, Ctx(None, lex, local, True)), lex, d)
+        dims.append(int(v))
+    zero: Any = "" if comp.type_name == "String" else (
+        False if comp.type_name == "Boolean" else 0)
+    for n in reversed(dims):
+        zero = [copy.deepcopy(zero) for _ in range(n)]
+    return zero
+
+
+class _State:
+    __slots__ = ("steps",)
+
+    def __init__(self) -> None:
+        self.steps = 0
+
+
+def _symbolic(v: Any) -> bool:
+    if isinstance(v, list):
+        return any(_symbolic(x) for x in v)
+    return isinstance(v, Expr)
+
+
+def _run(stmts: tuple, ctx: Ctx, state: _State) -> None:
+    from .evaluate import evaluate
+
+    for st in stmts:
+        state.steps += 1
+        if state.steps > MAX_STEPS:
+            raise fail(ctx.lex, st, f"algorithm did not finish after {MAX_STEPS} statements "
+                       "(an endless loop?)")
+        t = type(st)
+        if t is A.Assign:
+            _assign(st, ctx)
+        elif t is A.StmtIf:
+            _if(st, ctx, state)
+        elif t is A.StmtFor:
+            _for(st, ctx, state)
+        elif t is A.StmtWhile:
+            while True:
+                c = evaluate(st.condition, ctx)
+                if _symbolic(c):
+                    raise fail(ctx.lex, st, "while-loop condition depends on time-varying "
+                               "values (not supported)")
+                if not c:
+                    break
+                try:
+                    _run(st.body, ctx, state)
+                except _Break:
+                    break
+                state.steps += 1
+                if state.steps > MAX_STEPS:
+                    raise fail(ctx.lex, st, f"while loop did not finish after {MAX_STEPS} "
+                               "statements")
+        elif t is A.StmtCall:
+            _call_statement(st, ctx)
+        elif t is A.Return:
+            raise _Return()
+        elif t is A.Break:
+            raise _Break()
+        elif t is A.StmtWhen:
+            raise fail(ctx.lex, st, "unsupported Modelica construct: when-statement in a "
+                       "function")
+        else:
+            raise fail(ctx.lex, st, f"unsupported statement {t.__name__}")
+
+
+def _if(st: A.StmtIf, ctx: Ctx, state: _State) -> None:
+    from .evaluate import evaluate
+
+    for k, (cond, body) in enumerate(st.branches):
+        c = evaluate(cond, ctx)
+        if not _symbolic(c):
+            if c:
+                _run(body, ctx, state)
+                return
+            continue
+        # a symbolic condition: both sides, merged
+        rest = A.StmtIf(st.branches[k + 1:], st.otherwise, st.pos) if st.branches[k + 1:] \
+            else None
+        then_vals = dict(ctx.loops)
+        else_vals = dict(ctx.loops)
+        then_vals = {n: copy.copy(v) for n, v in then_vals.items()}
+        else_vals = {n: copy.copy(v) for n, v in else_vals.items()}
+        try:
+            _run(body, Ctx(None, ctx.lex, then_vals, False), state)
+            if rest is not None:
+                _if(rest, Ctx(None, ctx.lex, else_vals, False), state)
+            else:
+                _run(st.otherwise, Ctx(None, ctx.lex, else_vals, False), state)
+        except (_Return, _Break):
+            raise fail(ctx.lex, st, "return/break under a time-varying condition (not "
+                       "supported)") from None
+        for name in set(then_vals) | set(else_vals):
+            a, b = then_vals.get(name), else_vals.get(name)
+            if a is b:
+                ctx.loops[name] = a
+            elif a is None or b is None:
+                raise fail(ctx.lex, st, f"{name} is assigned in one branch only of an if "
+                           "on a time-varying condition")
+            else:
+                ctx.loops[name] = _merge(c, a, b, ctx, st)
+        return
+    _run(st.otherwise, ctx, state)
+
+
+def _merge(c: Any, a: Any, b: Any, ctx: Ctx, node: Any) -> Any:
+    if isinstance(a, list) and isinstance(b, list):
+        return [_merge(c, x, y, ctx, node) for x, y in zip(a, b, strict=True)]
+    if isinstance(a, str) or isinstance(b, str):
+        if a == b:
+            return a
+        raise fail(ctx.lex, node, "a String depends on a time-varying condition")
+    if _same(a, b):
+        return a
+    return _if_else(c, a, b, ctx, node)
+
+
+def _same(a: Any, b: Any) -> bool:
+    if isinstance(a, Expr) or isinstance(b, Expr):
+        return a is b
+    try:
+        return bool(a == b)
+    except Exception:  # noqa: BLE001
+        return False
+
+
+def _for(st: A.StmtFor, ctx: Ctx, state: _State) -> None:
+    from .evaluate import _iterate
+
+    saved = {n: ctx.loops[n] for n, _ in st.indices if n in ctx.loops}
+    try:
+        for loops in _iterate(st.indices, ctx, st):
+            for n, v in loops.items():
+                if n in dict(st.indices):
+                    ctx.loops[n] = v
+            try:
+                _run(st.body, ctx, state)
+            except _Break:
+                break
+    finally:
+        for n, _ in st.indices:
+            ctx.loops.pop(n, None)
+        ctx.loops.update(saved)
+
+
+def _assign(st: A.Assign, ctx: Ctx) -> None:
+    from .evaluate import evaluate
+
+    target = st.target
+    if isinstance(target, A.TupleExpr):
+        call = st.value
+        if not isinstance(call, A.Call):
+            raise fail(ctx.lex, st, "a tuple assignment needs a function call on the right")
+        values = call_outputs(call, ctx)
+        for item, v in zip(target.items, values, strict=False):
+            if item is not None:
+                _store(item, v, ctx, st)
+        return
+    _store(target, evaluate(st.value, ctx), ctx, st)
+
+
+def call_outputs(call: A.Call, ctx: Ctx) -> tuple:
+    """All outputs of a function call (for tuple assignments and equations)."""
+    from .evaluate import evaluate
+    from .functions import resolve_function
+
+    scope = resolve_function(call, ctx)
+    if scope is None:
+        raise fail(ctx.lex, call, f"{call.func.dotted}() returns one value; a tuple target "
+                   "needs a Modelica function with several outputs")
+    args = [evaluate(a, ctx) for a in call.args]
+    kwargs = {k: evaluate(v, ctx) for k, v in call.kwargs.items()}
+    return apply_function(scope, args, kwargs, ctx, call, all_outputs=True)
+
+
+def _store(ref: Any, value: Any, ctx: Ctx, node: Any) -> None:
+    from .evaluate import evaluate
+
+    if not isinstance(ref, A.Ref) or len(ref.parts) != 1:
+        raise fail(ctx.lex, node, "assignment to a record field or a non-variable is not "
+                   "supported")
+    name, subs = ref.parts[0]
+    if name not in ctx.loops:
+        raise fail(ctx.lex, node, f"assignment to {name!r}, which is not a variable of the "
+                   "function")
+    if not subs:
+        ctx.loops[name] = copy.deepcopy(value) if isinstance(value, list) else value
+        return
+    cur = ctx.loops[name]
+    num = Ctx(None, ctx.lex, ctx.loops, False)
+    idx = []
+    for s in subs:
+        if isinstance(s, A.Colon):
+            idx.append(None)
+            continue
+        v = evaluate(s, num)
+        if _symbolic(v):
+            raise fail(ctx.lex, node, f"subscript of {name} depends on time-varying values")
+        idx.append(v)
+    ctx.loops[name] = _set(cur, idx, value, ctx, node, name)
+
+
+def _set(cur: Any, idx: list, value: Any, ctx: Ctx, node: Any, name: str) -> Any:
+    if not idx:
+        return value
+    if not isinstance(cur, list):
+        raise fail(ctx.lex, node, f"{name}: too many subscripts")
+    head, rest = idx[0], idx[1:]
+    cur = list(cur)
+    if head is None:
+        positions = list(range(len(cur)))
+        vals = value if isinstance(value, list) else [value] * len(cur)
+    elif isinstance(head, list):
+        positions = [int(i) - 1 for i in head]
+        vals = value if isinstance(value, list) else [value] * len(positions)
+    else:
+        positions = [int(head) - 1]
+        vals = [value]
+    if len(vals) != len(positions):
+        raise fail(ctx.lex, node, f"{name}: {len(vals)} values for {len(positions)} elements")
+    for p, v in zip(positions, vals, strict=True):
+        if not 0 <= p < len(cur):
+            raise fail(ctx.lex, node, f"{name}[{p + 1}]: index out of range 1..{len(cur)}")
+        cur[p] = _set(cur[p], rest, v, ctx, node, name)
+    return cur
+
+
+def _call_statement(st: A.StmtCall, ctx: Ctx) -> None:
+    from .evaluate import evaluate
+
+    call = st.call
+    name = call.func.dotted
+    if name == "assert":
+        cond = evaluate(call.args[0], ctx)
+        if _symbolic(cond):
+            return                  # checked while simulating only for model equations
+        if not cond:
+            msg = evaluate(call.args[1], ctx) if len(call.args) > 1 else "assertion failed"
+            level = call.kwargs.get("level") or (call.args[2] if len(call.args) > 2 else None)
+            if level is not None and "warning" in getattr(level, "dotted", ""):
+                return
+            raise fail(ctx.lex, st, f"assert failed: {msg}")
+        return
+    if name == "terminate":
+        raise fail(ctx.lex, st, "terminate() in a function")
+    evaluate(call, ctx)
+
+
+def _external(fn: FunctionDef, local: dict, ctx: Ctx, node: Any) -> None:
+    from .evaluate import evaluate
+
+    ext, lex = fn.external  # type: ignore[misc]
+    try:
+        from ..externals import IMPLEMENTATIONS
+    except ImportError:
+        IMPLEMENTATIONS = {}
+    cname = ext.function or fn.scope.cdef.name
+    impl = IMPLEMENTATIONS.get(cname)
+    if impl is None:
+        raise fail(lex, ext, f"unsupported Modelica construct: external function {cname} "
+                   f"(called by {fn.name}) is not implemented")
+    ectx = Ctx(None, lex, local, False)
+    if ext.function is None:
+        arg_nodes = [A.Ref(((c.name, None),)) for c, _, _ in fn.inputs]
+        out_names = [c.name for c, _, _ in fn.outputs]
+        args = [local[c.name] for c, _, _ in fn.inputs]
+    else:
+        arg_nodes = list(ext.args)
+        args = [evaluate(a, ectx) for a in arg_nodes]
+        out_names = []
+        if ext.output is not None:
+            out_names.append(ext.output.parts[0][0])
+        outputs = {c.name for c, _, _ in fn.outputs}
+        for a in arg_nodes:
+            if isinstance(a, A.Ref) and len(a.parts) == 1 and a.parts[0][0] in outputs:
+                out_names.append(a.parts[0][0])
+    try:
+        got = impl(*args)
+    except NotConstant:
+        raise
+    except Exception as err:  # noqa: BLE001 -- one line naming the function
+        raise fail(ctx.lex, node, f"{fn.name}(): {err}") from None
+    if len(out_names) == 1:
+        local[out_names[0]] = got
+    elif len(out_names) > 1:
+        if not isinstance(got, tuple) or len(got) != len(out_names):
+            raise fail(lex, ext, f"external {cname} returned {type(got).__name__}, expected "
+                       f"{len(out_names)} outputs")
+        for n, v in zip(out_names, got, strict=True):
+            local[n] = v
