@@ -25,9 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from . import ast as A
-
 from .errors import ModelicaError, ModelicaExportError, ModelicaSyntaxError
-
 from .library_path import add_modelica_path, modelica_path
 
 __all__ = ["load_modelica", "load_modelica_text", "load_class", "add_modelica_path",

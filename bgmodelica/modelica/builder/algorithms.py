@@ -118,7 +118,7 @@ def apply_function(scope: S.ClassScope, args: list, kwargs: dict, ctx: Ctx, node
         if name not in names:
             raise fail(ctx.lex, node, f"{fn.name}() has no input {name!r}; it has: "
                        f"{', '.join(names) or 'none'}")
-    for k, (comp, lex, info) in enumerate(fn.inputs):
+    for k, (comp, _, _) in enumerate(fn.inputs):
         if k < len(args):
             local[comp.name] = args[k]
             if comp.name in kwargs:
