@@ -161,11 +161,14 @@ class Curve:
         ``NoExtrapolation`` continues the end slopes: check :attr:`u_min`/:attr:`u_max`."""
         if self.x.size > 1 and self.extrapolation == PERIODIC:
             u = u - self.period * floor((u - self.u_min) / self.period)
-        out = _poly(self.coefs[-1], u - float(self.bases[-1]), order)
-        for k in range(len(self.starts) - 2, -1, -1):
-            piece = _poly(self.coefs[k], u - float(self.bases[k]), order)
-            out = if_else(u < float(self.starts[k + 1]), piece, out)
-        return out
+
+        def build(lo: int, hi: int) -> Any:       # balanced: depth log2(pieces)
+            if lo == hi:
+                return _poly(self.coefs[lo], u - float(self.bases[lo]), order)
+            mid = (lo + hi + 1) // 2
+            return if_else(u < float(self.starts[mid]), build(lo, mid - 1), build(mid, hi))
+
+        return build(0, len(self.starts) - 1)
 
 
 def _poly(c: np.ndarray, s: Any, order: int) -> Any:
