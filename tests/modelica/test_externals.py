@@ -10,7 +10,7 @@ import pytest
 from scipy.interpolate import Akima1DInterpolator, PchipInterpolator
 from scipy.io import loadmat, savemat
 
-from bgmodelica.core.expr import Expr, Leaf, to_sx
+from bgmodelica.core.expr import Expr, Leaf, differentiate, to_sx
 from bgmodelica.errors import ModelError
 from bgmodelica.modelica.externals import (
     IMPLEMENTATIONS as X,
@@ -18,6 +18,7 @@ from bgmodelica.modelica.externals import (
 from bgmodelica.modelica.externals import (
     ExtrapolationError,
     TableError,
+    in_range,
     time_breakpoints,
     valid_range,
 )
@@ -94,6 +95,10 @@ def test_linear_interpolation_and_extrapolation_modes():
     with pytest.raises(ExtrapolationError, match="outside the table range"):
         get(strict, 4.5)
     assert valid_range(strict) == (0.0, 4.0)
+    assert in_range(strict, 4.0) and not in_range(strict, -0.1)
+    ok = lowered(lambda u: in_range(strict, u))
+    assert [ok(u) for u in (-0.1, 0.0, 2.0, 4.0, 4.1)] == [0, 1, 1, 1, 0]
+    assert X[T1D + "getValue"](strict, 1, ca.SX(2.0)) == 4.0
     assert X[T1D + "minimumAbscissa"](t) == 0 and X[T1D + "maximumAbscissa"](t) == 4
     assert X[T1D + "close"](t) is None
 
@@ -188,6 +193,14 @@ def test_symbolic_equals_numeric(smooth, extrap):
         g = lowered(lambda u: X[T1D + "getDerValue"](t, 1, u, 2.0))
         for u in us[:50]:
             assert g(u) == pytest.approx(X[T1D + "getDerValue"](t, 1, u, 2.0), abs=1e-12)
+
+
+@pytest.mark.parametrize("smooth", [LIN, AKIMA, STEFFEN])
+def test_differentiating_the_closed_form_gives_get_der_value(smooth):
+    t = table1d(SMOOTH_TABLE, smooth, PERIODIC)
+    f = lowered(lambda u: differentiate(get(t, u), lambda sym: 1.0))
+    for u in np.linspace(-3.0, 7.0, 37):
+        assert f(u) == pytest.approx(X[T1D + "getDerValue"](t, 1, u, 1.0), abs=1e-12)
 
 
 def test_symbolic_casadi_input():
@@ -338,6 +351,10 @@ def test_time_table_one_row_and_errors():
     ok = time_table([[0, 0], [1, 0], [1, 1], [2, 1]], extrap=NOEXT)
     with pytest.raises(ExtrapolationError):
         X[TT + "getValue"](ok, 1, 2.5, NO_EVENT, 2.0)
+    late = time_table([[0, 0], [1, 1]], extrap=NOEXT, start=1.0, shift=2.0)
+    assert [in_range(late, s) for s in (0.5, 1.5, 2.5, 3.5)] == [True, False, True, False]
+    cond = lowered(lambda s: in_range(late, s))
+    assert [cond(s) for s in (0.5, 1.5, 2.5, 3.5)] == [1, 0, 1, 0]
 
 
 # -- strings, files, FFT ----------------------------------------------------------------------

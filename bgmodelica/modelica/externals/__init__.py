@@ -21,11 +21,12 @@ from typing import Any
 
 from . import fft, files, strings, tables
 from .errors import ExternalFunctionError, ExtrapolationError, TableError
-from .tables import CombiTable1D, CombiTimeTable, time_breakpoints, valid_range
+from .tables import CombiTable1D, CombiTimeTable, in_range, time_breakpoints, valid_range
 
 IMPLEMENTATIONS: dict[str, Callable[..., Any]] = {
     **tables.REGISTRY, **strings.REGISTRY, **files.REGISTRY, **fft.REGISTRY,
 }
 
 __all__ = ["IMPLEMENTATIONS", "CombiTable1D", "CombiTimeTable", "time_breakpoints",
-           "valid_range", "ExternalFunctionError", "TableError", "ExtrapolationError"]
+           "valid_range", "in_range", "ExternalFunctionError", "TableError",
+           "ExtrapolationError"]

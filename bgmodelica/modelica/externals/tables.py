@@ -22,8 +22,8 @@ Conventions (from the MSL documentation):
   formula wrapped in ``noEvent`` (lookups generate no state events), right-continuous at
   jumps; a time table ignores the event arguments then (schedule
   :func:`time_breakpoints` as time events instead). ``NoExtrapolation`` raises for numbers;
-  symbolically it continues the end slopes and :func:`valid_range` gives the range to
-  assert.
+  symbolically it continues the end slopes, and :func:`in_range` gives the condition to
+  assert (:func:`valid_range` the range).
 """
 
 from __future__ import annotations
@@ -33,6 +33,7 @@ import sys
 from collections.abc import Callable
 from typing import Any
 
+import casadi as ca
 import numpy as np
 
 from ...core.expr import Expr, Op, if_else
@@ -259,6 +260,24 @@ def valid_range(table: _Table) -> tuple[float, float]:
     """Abscissa range [u_min, u_max] of a table (time tables: unshifted, like the MSL's
     ``t_minScaled``/``t_maxScaled``), where ``NoExtrapolation`` lookups are allowed."""
     return table.u_min, table.u_max
+
+
+def in_range(table: _Table, u: Any) -> Any:
+    """Whether a lookup at ``u`` stays in the table range (a Boolean, or a Boolean expression
+    for a symbolic ``u``): the condition a ``NoExtrapolation`` table asserts. For a time table
+    ``u`` is the time: before ``startTime`` any time is allowed, after it ``time - shiftTime``
+    must lie in the range."""
+    lo, hi = table.u_min, table.u_max
+    shift = table.shift_time if isinstance(table, CombiTimeTable) else 0.0
+    if not is_symbolic(u):
+        ok = lo <= float(u) - shift <= hi
+        return ok or (isinstance(table, CombiTimeTable) and float(u) < table.start_time)
+    land, lor = (ca.logic_and, ca.logic_or) if isinstance(u, (ca.SX, ca.MX)) else \
+        (lambda a, b: a & b, lambda a, b: a | b)
+    ok = land(lo <= u - shift, u - shift <= hi)
+    if isinstance(table, CombiTimeTable):
+        ok = lor(u < table.start_time, ok)
+    return _no_event(ok)
 
 
 # -- entry points (arguments as in the MSL's external "C" calls) -------------------------------
