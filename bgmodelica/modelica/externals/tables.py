@@ -198,7 +198,7 @@ class CombiTimeTable(_Table):
         return ev
 
     def _events_between(self, a: float, b: float) -> np.ndarray:
-        """Table events in [a, b] (global time), unsorted duplicates removed."""
+        """Table events in [a, b] (global time [s]), sorted, without duplicates."""
         ev = self.events
         if not ev.size or b < a:
             return np.empty(0)
