@@ -111,6 +111,15 @@ class ArrayComp:
 
 
 @dataclass(slots=True)
+class PartialFunction:
+    """``function f(a=1)`` passed as a call argument: ``f`` with some inputs bound."""
+
+    func: str
+    kwargs: dict[str, Any]
+    pos: Pos = (0, 0)
+
+
+@dataclass(slots=True)
 class Matrix:
     rows: tuple[tuple, ...]
     pos: Pos = (0, 0)
@@ -190,6 +199,20 @@ class TupleExpr:
 
 
 # -- algorithms ----------------------------------------------------------------------------------
+
+
+class Statements(tuple):
+    """The statements of one algorithm section (a tuple); ``pos`` is the section's keyword."""
+
+    pos: Pos
+
+    def __new__(cls, items=(), pos: Pos = (0, 0)) -> Statements:
+        self = super().__new__(cls, items)
+        self.pos = pos
+        return self
+
+    def __reduce__(self):
+        return (Statements, (tuple(self), self.pos))
 
 
 @dataclass(slots=True)
@@ -327,6 +350,9 @@ class ClassDef:
     encapsulated: bool = False
     protected: frozenset[str] = frozenset()   # names of the elements declared protected
     directory: str = ""           # a package stored as a folder: its path (library loading)
+    # ``redeclare model extends B(mod)``: the modification of the inherited ``B`` (an empty
+    # Modification when none); None for an ordinary class
+    class_extends: Modification | None = None
 
     @property
     def full_name(self) -> str:

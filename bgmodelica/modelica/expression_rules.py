@@ -126,9 +126,6 @@ class ExpressionRules(Transformer):
     def for_index(self, meta, ch):
         return (ident_text(ch[0]), ch[1] if len(ch) > 1 else None)
 
-    def statement(self, meta, ch):
-        return A.Unsupported("algorithm statement", node_pos(meta))
-
     # -- expressions -------------------------------------------------------------------------
     def if_expression(self, meta, ch):
         branches = [(ch[0], ch[1])]
@@ -213,9 +210,31 @@ class ExpressionRules(Transformer):
     def named_argument(self, meta, ch):
         return _Named((ident_text(ch[0]), ch[1]))
 
-    def function_argument_partial(self, meta, ch):
-        raise self._syntax_error(meta, "unsupported Modelica construct: functional arguments "
-                                      "('function f(...)' in a call)")
+    def function_partial_application(self, meta, ch):
+        kwargs = ch[1] if len(ch) > 1 else {}
+        return A.PartialFunction(ch[0], kwargs, node_pos(meta))
+
+    def named_argument_list(self, meta, ch):
+        return {ident_text(ch[i]): ch[i + 1] for i in range(0, len(ch), 2)}
+
+    def paren(self, meta, ch):
+        return ch[0]
+
+    def output_expression_list(self, meta, ch):
+        """``(e)`` is ``e``; ``(a, , b)`` a :class:`TupleExpr` (None for an omitted item)."""
+        items: list = [None]
+        commas = 0
+        for c in ch:
+            if isinstance(c, Token) and c.type == "COMMA":
+                items.append(None)
+                commas += 1
+            else:
+                items[-1] = c
+        if commas == 0 and items[0] is not None:
+            return items[0]
+        if commas == 0:
+            items = []
+        return A.TupleExpr(tuple(items), node_pos(meta))
 
     def array(self, meta, ch):
         c = ch[0]

@@ -18,18 +18,13 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 
 from . import ast as A
 from .errors import ModelicaError, ModelicaSyntaxError
-from .expression_rules import ExpressionRules, ident_text, node_pos, token_pos
+from .expression_rules import ident_text, node_pos, token_pos
+from .statement_rules import StatementRules
 
 _GRAMMAR = Path(__file__).with_name("grammar.lark")
 
 #: keywords and words of full Modelica that the subset does not read, with what they start
 UNSUPPORTED_WORDS = {
-    "algorithm": "algorithm sections",
-    "while": "while loops (algorithm statements)",
-    "external": "external functions",
-    "pure": "pure/impure functions",
-    "impure": "pure/impure functions",
-    "operator": "operator records and overloaded operators",
     "Clock": "synchronous (clocked) language elements",
     "subSample": "synchronous (clocked) language elements",
 }
@@ -55,8 +50,15 @@ class _Section(tuple):
     """``(kind, items)`` of a composition."""
 
 
+class _Prefixes(tuple):
+    """``(partial, purity, kind)`` of a class definition."""
+
+
+_PURITY = {"PURE": "pure", "IMPURE": "impure"}
+
+
 @v_args(meta=True)
-class _ToAst(ExpressionRules):
+class _ToAst(StatementRules):
     def __init__(self, file: str) -> None:
         super().__init__()
         self.file = file
@@ -82,14 +84,16 @@ class _ToAst(ExpressionRules):
         return ch[-1]
 
     # -- classes -----------------------------------------------------------------------------
-    def class_kind(self, meta, ch):
-        return " ".join(str(t) for t in ch)
+    def class_prefixes(self, meta, ch):
+        partial = bool(ch) and ch[0].type == "PARTIAL"
+        purity = next((_PURITY[t.type] for t in ch if t.type in _PURITY), "")
+        kind = " ".join(str(t) for t in ch if t.type != "PARTIAL" and t.type not in _PURITY)
+        return _Prefixes((partial, purity, kind))
 
     def class_definition(self, meta, ch):
         cdef: A.ClassDef = ch[-1]
-        kind = ch[-2]
-        cdef.kind = kind
-        cdef.partial = any(isinstance(t, Token) and t.type == "PARTIAL" for t in ch)
+        cdef.partial, cdef.purity, cdef.kind = ch[-2]
+        cdef.encapsulated = isinstance(ch[0], Token) and ch[0].type == "ENCAPSULATED"
         cdef.pos = node_pos(meta)
         cdef.file = self.file
         return cdef
@@ -106,6 +110,15 @@ class _ToAst(ExpressionRules):
         for el in cdef.elements:
             if isinstance(el, A.ClassDef):
                 el.parent = cdef
+        return cdef
+
+    def extends_class_specifier(self, meta, ch):
+        mod = A.Modification((), None, node_pos(meta))
+        if isinstance(ch[1], _ClassMod):
+            mod = A.Modification(tuple(ch[1]), None, node_pos(meta))
+            ch = [ch[0], *ch[2:]]
+        cdef = self.long_class_specifier(meta, ch)
+        cdef.class_extends = mod
         return cdef
 
     def short_class_specifier(self, meta, ch):
@@ -148,43 +161,45 @@ class _ToAst(ExpressionRules):
 
     def composition(self, meta, ch):
         out: dict[str, Any] = {"elements": [], "equations": [], "initial_equations": [],
-                               "annotation": None, "unsupported": []}
+                               "algorithms": [], "initial_algorithms": [], "annotation": None,
+                               "external": None}
         out["elements"].extend(ch[0])
+        protected: set[str] = set()
         for c in ch[1:]:
             if isinstance(c, _Section):
                 kind, items = c
-                if kind == "elements":
-                    out["elements"].extend(items)
-                elif kind == "equations":
-                    out["equations"].extend(items)
-                elif kind == "initial":
-                    out["initial_equations"].extend(items)
+                if kind == "protected":
+                    protected.update(e.name for e in items
+                                     if isinstance(e, (A.Component, A.ClassDef)))
+                    kind = "elements"
+                if kind in ("algorithms", "initial_algorithms"):
+                    out[kind].append(items)
                 else:
-                    out["unsupported"].append(items)
+                    out[kind].extend(items)
+            elif isinstance(c, A.External):
+                out["external"] = c
             elif isinstance(c, A.Modification):
                 out["annotation"] = c
+        out["protected"] = frozenset(protected)
         return out
 
     def public_section(self, meta, ch):
         return _Section(("elements", ch[0]))
 
-    protected_section = public_section
+    def protected_section(self, meta, ch):
+        return _Section(("protected", ch[0]))
 
     def equation_section(self, meta, ch):
         return _Section(("equations", list(ch)))
 
     def initial_equation_section(self, meta, ch):
-        return _Section(("initial", list(ch[1:])))
+        return _Section(("initial_equations", list(ch[1:])))
 
     def algorithm_section(self, meta, ch):
-        return _Section(("unsupported", A.Unsupported("algorithm section", node_pos(meta))))
+        return _Section(("algorithms", A.Statements(ch[1:], token_pos(ch[0]))))
 
     def initial_algorithm_section(self, meta, ch):
-        return _Section(("unsupported", A.Unsupported("initial algorithm section",
-                                                      node_pos(meta))))
-
-    def external_clause(self, meta, ch):
-        return _Section(("unsupported", A.Unsupported("external function", node_pos(meta))))
+        return _Section(("initial_algorithms", A.Statements(ch[1:], token_pos(ch[0]))))
 
     def element_list(self, meta, ch):
         out = []
@@ -201,16 +216,14 @@ class _ToAst(ExpressionRules):
     def declaration_element(self, meta, ch):
         prefixes = frozenset(c for c in ch if isinstance(c, str) and not isinstance(c, Token)
                              and c in ("redeclare", "final", "inner", "outer", "replaceable"))
-        body = next(c for c in ch if isinstance(c, (A.ClassDef, list)))
-        constrained = next((c for c in ch if isinstance(c, tuple) and len(c) == 3
-                            and c[0] == "constrainedby"), None)
+        k = next(i for i, c in enumerate(ch) if isinstance(c, (A.ClassDef, list)))
+        body = ch[k]
+        _constrain(body, ch[k + 1:])
         if isinstance(body, A.ClassDef):
             body.element_prefixes = prefixes
             return body
         for comp in body:
             comp.element_prefixes = prefixes
-            if constrained is not None:
-                comp.constrainedby = constrained[1]
         return body
 
     def constraining_clause(self, meta, ch):
@@ -224,6 +237,13 @@ class _ToAst(ExpressionRules):
 
     def import_name(self, meta, ch):
         return A.Import(None, ch[0], False, node_pos(meta))
+
+    def import_some(self, meta, ch):
+        """``import A.B.{c, d}``: one import a name."""
+        return [A.Import(None, f"{ch[0]}.{name}", False, node_pos(meta)) for name in ch[2]]
+
+    def import_list(self, meta, ch):
+        return [ident_text(t) for t in ch]
 
     def extends_clause(self, meta, ch):
         mod = None
@@ -322,11 +342,27 @@ class _ToAst(ExpressionRules):
         return A.Redeclare(ch[-1], "each" in flags, node_pos(meta))
 
     def element_replaceable(self, meta, ch):
+        _constrain(ch[1], ch[2:])
         return ch[1]
 
 
 class _CompList(list):
     """The component list of a component clause."""
+
+
+def _constrain(body: Any, rest: list) -> None:
+    """Apply ``constrainedby T(mod) "description" annotation(...)`` (``rest``: the parsed
+    constraining clause and comment, when given) to a component list, a component or a
+    class; the description and annotation count when the element has none of its own."""
+    if not rest:
+        return
+    (_, type_name, _mod), (desc, ann) = rest[0], rest[1]
+    items = body if isinstance(body, list) else [body]
+    for item in items:
+        if isinstance(item, A.Component):
+            item.constrainedby = type_name
+        item.description = item.description or desc
+        item.annotation = item.annotation or ann
 
 
 def parse_text(text: str, file: str = "<string>") -> A.StoredDefinition:

@@ -106,10 +106,23 @@ def class_view(scope: S.ClassScope, _stack: tuple = ()) -> ClassView:
         view.equations.append((eq, scope))
     for eq in cdef.initial_equations:
         view.initial.append((eq, scope))
-    for u in cdef.unsupported:
+    for u in refused(cdef):
         view.unsupported.append((u, scope))
     scope._view = view
     return view
+
+
+def refused(cdef: A.ClassDef) -> list[A.Unsupported]:
+    """What a class holds that the builder does not implement yet (refused when a model is
+    instantiated): algorithm sections, external clauses, ``model extends``."""
+    out = list(cdef.unsupported)
+    out += [A.Unsupported("algorithm section", s.pos) for s in cdef.algorithms]
+    out += [A.Unsupported("initial algorithm section", s.pos) for s in cdef.initial_algorithms]
+    if cdef.external is not None:
+        out.append(A.Unsupported("external function", cdef.external.pos))
+    if cdef.class_extends is not None:
+        out.append(A.Unsupported("class extends ('model extends B')", cdef.pos))
+    return out
 
 
 def _scalar_base(scope: S.ClassScope) -> bool:
