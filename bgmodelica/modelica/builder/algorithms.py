@@ -22,7 +22,7 @@ from .arith import _if_else
 from .base import Ctx, NotConstant, fail, numeric_value
 
 #: statements run per call before a loop is taken for endless
-MAX_STEPS = 2_000_000
+MAX_STEPS = 300_000
 
 
 class _Return(Exception):
@@ -197,10 +197,12 @@ def _initial(comp: A.Component, lex: S.ClassScope, local: dict, info: Any) -> An
 
 
 class _State:
-    __slots__ = ("steps",)
+    __slots__ = ("steps", "whens", "leaves")
 
     def __init__(self) -> None:
         self.steps = 0
+        self.whens: list | None = None        # collects when-statements in a model
+        self.leaves: dict = {}                # the model variables a model's algorithm assigns
 
 
 def _symbolic(v: Any) -> bool:
@@ -247,8 +249,9 @@ def _run(stmts: tuple, ctx: Ctx, state: _State) -> None:
         elif t is A.Break:
             raise _Break()
         elif t is A.StmtWhen:
-            raise fail(ctx.lex, st, "unsupported Modelica construct: when-statement in a "
-                       "function")
+            if state.whens is None:
+                raise fail(ctx.lex, st, "a when-statement in a function")
+            _when_statement(st, ctx, state)
         else:
             raise fail(ctx.lex, st, f"unsupported statement {t.__name__}")
 
@@ -271,11 +274,11 @@ def _if(st: A.StmtIf, ctx: Ctx, state: _State) -> None:
         then_vals = {n: copy.copy(v) for n, v in then_vals.items()}
         else_vals = {n: copy.copy(v) for n, v in else_vals.items()}
         try:
-            _run(body, Ctx(None, ctx.lex, then_vals, False), state)
+            _run(body, Ctx(ctx.env, ctx.lex, then_vals, False), state)
             if rest is not None:
-                _if(rest, Ctx(None, ctx.lex, else_vals, False), state)
+                _if(rest, Ctx(ctx.env, ctx.lex, else_vals, False), state)
             else:
-                _run(st.otherwise, Ctx(None, ctx.lex, else_vals, False), state)
+                _run(st.otherwise, Ctx(ctx.env, ctx.lex, else_vals, False), state)
         except (_Return, _Break):
             raise fail(ctx.lex, st, "return/break under a time-varying condition (not "
                        "supported)") from None
@@ -376,7 +379,7 @@ def _store(ref: Any, value: Any, ctx: Ctx, node: Any) -> None:
         ctx.loops[name] = copy.deepcopy(value) if isinstance(value, list) else value
         return
     cur = ctx.loops[name]
-    num = Ctx(None, ctx.lex, ctx.loops, False)
+    num = Ctx(ctx.env, ctx.lex, ctx.loops, False)
     idx = []
     for s in subs:
         if isinstance(s, A.Colon):
@@ -477,3 +480,114 @@ def _external(fn: FunctionDef, local: dict, ctx: Ctx, node: Any) -> None:
                        f"{len(out_names)} outputs")
         for n, v in zip(out_names, got, strict=True):
             local[n] = v
+
+
+# -- algorithm sections of models -----------------------------------------------------------
+
+
+def section_equations(stmts: A.Statements, ctx: Ctx, out: list, initial: bool) -> None:
+    """The equations of an algorithm section of a model (specification 11.1): the section is
+    run symbolically; each variable it assigns outside ``when`` becomes ``v = value``, each
+    ``when``-statement a when-equation of the variables its branches assign (starting from
+    their ``pre`` values). In an initial algorithm the assignments become initial
+    equations."""
+    from .equations import _equation
+    from .evaluate import evaluate
+
+    names = _targets(stmts)
+    leaves = {n: evaluate(A.Ref(((n, None),), stmts.pos), ctx) for n in names}
+    local = dict(ctx.loops)
+    for n in names:
+        local[n] = _pre(leaves[n]) if not initial else None
+    state = _State()
+    state.whens = []
+    state.leaves = leaves
+    try:
+        _run(tuple(stmts), Ctx(ctx.env, ctx.lex, local, False), state)
+    except _Return:
+        pass
+    in_when: set[str] = set()
+    for branches in state.whens:
+        for _, assigned in branches:
+            in_when |= set(assigned)
+    for n in names:
+        if n in in_when:
+            continue
+        if local.get(n) is None:
+            raise fail(ctx.lex, stmts, f"{n} is not assigned on every path of the algorithm")
+        _equation(leaves[n], local[n], ctx, stmts, out)
+    for branches in state.whens:
+        out.append(_when_of(branches, leaves, ctx, stmts))
+
+
+def _when_of(branches: list, leaves: dict, ctx: Ctx, node: Any) -> Any:
+    from ...core import hybrid as H
+    from .equations import _equation
+
+    union: list[str] = []
+    for _, assigned in branches:
+        union += [n for n in assigned if n not in union]
+    result = None
+    for cond, assigned in branches:
+        eqs: list = []
+        for n in union:
+            _equation(leaves[n], assigned.get(n, _pre(leaves[n])), ctx, node, eqs)
+        result = H.when(cond, *eqs) if result is None else result.elsewhen(cond, *eqs)
+    return result
+
+
+def _pre(v: Any) -> Any:
+    from ...core import hybrid as H
+
+    if isinstance(v, list):
+        return [_pre(x) for x in v]
+    try:
+        return H.pre(v)
+    except Exception:  # noqa: BLE001 -- not a variable: its value
+        return v
+
+
+def _targets(stmts: Any) -> list[str]:
+    """The names assigned anywhere in ``stmts`` (first part of each target), in order."""
+    out: list[str] = []
+
+    def add(ref: Any) -> None:
+        if isinstance(ref, A.Ref):
+            n = ref.parts[0][0]
+            if n not in out:
+                out.append(n)
+
+    def walk(items: Any) -> None:
+        for st in items:
+            if isinstance(st, A.Assign):
+                if isinstance(st.target, A.TupleExpr):
+                    for item in st.target.items:
+                        add(item)
+                else:
+                    add(st.target)
+            elif isinstance(st, (A.StmtIf, A.StmtWhen)):
+                for _, body in st.branches:
+                    walk(body)
+                walk(getattr(st, "otherwise", ()))
+            elif isinstance(st, (A.StmtFor, A.StmtWhile)):
+                walk(st.body)
+
+    walk(stmts)
+    return out
+
+
+def _when_statement(st: A.StmtWhen, ctx: Ctx, state: _State) -> None:
+    """A when-statement of a model's algorithm: each branch run from the ``pre`` values of
+    what it assigns; collected for :func:`section_equations`."""
+    from .evaluate import evaluate
+
+    branches = []
+    for cond, body in st.branches:
+        c = evaluate(cond, ctx)
+        names = _targets(body)
+        local = dict(ctx.loops)
+        for n in names:
+            local[n] = _pre(state.leaves[n]) if n in state.leaves else None
+        _run(body, Ctx(ctx.env, ctx.lex, local, False), state)
+        branches.append((c, {n: local[n] for n in names}))
+    state.whens.append(branches)

@@ -106,6 +106,9 @@ def class_view(scope: S.ClassScope, _stack: tuple = ()) -> ClassView:
         view.equations.append((eq, scope))
     for eq in cdef.initial_equations:
         view.initial.append((eq, scope))
+    if cdef.kind not in ("function", "operator function"):
+        view.equations.extend((s, scope) for s in cdef.algorithms)
+        view.initial.extend((s, scope) for s in cdef.initial_algorithms)
     for u in refused(cdef):
         view.unsupported.append((u, scope))
     scope._view = view
@@ -116,8 +119,6 @@ def refused(cdef: A.ClassDef) -> list[A.Unsupported]:
     """What a class holds that the builder does not implement yet (refused when a model is
     instantiated): algorithm sections, external clauses, ``model extends``."""
     out = list(cdef.unsupported)
-    out += [A.Unsupported("algorithm section", s.pos) for s in cdef.algorithms]
-    out += [A.Unsupported("initial algorithm section", s.pos) for s in cdef.initial_algorithms]
     if cdef.external is not None:
         out.append(A.Unsupported("external function", cdef.external.pos))
     if cdef.class_extends is not None:

@@ -51,7 +51,13 @@ def equations_of(env: Env, eqs: list, initial: bool = False) -> list:
 
 def _eval_equation(eq: Any, ctx: Ctx, out: list, initial: bool) -> None:
     try:
-        if isinstance(eq, A.EqSimple):
+        if isinstance(eq, A.Statements):
+            from .algorithms import section_equations
+
+            section_equations(eq, ctx, out, initial)
+        elif isinstance(eq, A.EqSimple) and isinstance(eq.lhs, A.TupleExpr):
+            _tuple_equation(eq, ctx, out)
+        elif isinstance(eq, A.EqSimple):
             try:
                 a = evaluate(eq.lhs, ctx)
                 b = evaluate(eq.rhs, ctx)
@@ -84,6 +90,21 @@ def _eval_equation(eq: Any, ctx: Ctx, out: list, initial: bool) -> None:
         if isinstance(err, ModelicaError):
             raise
         raise fail(ctx.lex, eq, str(err)) from None
+
+
+def _tuple_equation(eq: A.EqSimple, ctx: Ctx, out: list) -> None:
+    """``(a, , b) = f(x)``: one equation per named output."""
+    from .algorithms import call_outputs
+
+    if not isinstance(eq.rhs, A.Call):
+        raise fail(ctx.lex, eq, "a tuple equation needs a function call on the right")
+    try:
+        values = call_outputs(eq.rhs, ctx)
+        for item, v in zip(eq.lhs.items, values, strict=False):
+            if item is not None:
+                _equation(evaluate(item, ctx), v, ctx, eq, out)
+    except NotConstant as err:
+        raise fail(ctx.lex, eq, f"cannot evaluate: {err.what}") from None
 
 
 def _eval_call_equation(eq: A.EqCall, ctx: Ctx, out: list, initial: bool) -> None:
@@ -197,18 +218,20 @@ def _eval_when(eq: A.EqWhen, ctx: Ctx) -> Any:
     return result
 
 
-def _declaration_equations(inst: Element, bindings: list, connector: bool) -> None:
+def _declaration_equations(inst: Element, bindings: list, connector: bool,
+                           owner: Element | None = None) -> None:
     """``Real x = expr`` (in the class or from a modifier): the equation ``x = expr``,
-    evaluated where the binding is written."""
+    evaluated where the binding is written. A connector's bindings (``Support s(phi = p)``)
+    become equations of ``owner``, the component that declares the connector."""
     eqs: list = []
     for sym, m, info in bindings:
         lex = m.lex or info.lex
-        if connector:
-            raise fail(lex, m.pos, f"{info.comp.name}: a connector variable cannot have a "
-                       "declaration equation")
+        if connector and owner is None:
+            raise fail(lex, m.pos, f"{info.comp.name}: a top-level connector variable cannot "
+                       "have a declaration equation")
         try:
             value = m.value(False)
         except NotConstant as err:
             raise fail(lex, m.pos, f"{info.comp.name}: {err.what}") from None
         _equation(sym.leaf, value, Ctx(None, lex, {}, False), m, eqs)
-    inst._equations.extend(eqs)
+    (owner if connector else inst)._equations.extend(eqs)

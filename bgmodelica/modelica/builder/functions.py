@@ -161,8 +161,19 @@ def _leaf_arg(x: Any, ctx: Ctx, node: Any, name: str) -> Any:
     return x
 
 
+def _variables_ctx(ctx: Ctx) -> Ctx:
+    """``ctx`` where names refer to the model's variables, not to the values an algorithm
+    section has assigned them so far (``pre(n)`` after ``n := ...``); loop indices stay."""
+    if ctx.env is None or not ctx.loops:
+        return ctx
+    loops = {k: v for k, v in ctx.loops.items()
+             if isinstance(v, (int, S.EnumValue)) and not isinstance(v, bool)}
+    return Ctx(ctx.env, ctx.lex, loops, ctx.numeric)
+
+
 def _fn_pre(node: A.Call, ctx: Ctx) -> Any:
     _symbolic(ctx, node, "pre")
+    ctx = _variables_ctx(ctx)
     (x,) = _args(node, ctx, 1, "pre")
     x = _leaf_arg(x, ctx, node, "pre")
     return _elementwise(H.pre)(x)
@@ -170,12 +181,14 @@ def _fn_pre(node: A.Call, ctx: Ctx) -> Any:
 
 def _fn_edge(node: A.Call, ctx: Ctx) -> Any:
     _symbolic(ctx, node, "edge")
+    ctx = _variables_ctx(ctx)
     (x,) = _args(node, ctx, 1, "edge")
     return _elementwise(H.edge)(_leaf_arg(x, ctx, node, "edge"))
 
 
 def _fn_change(node: A.Call, ctx: Ctx) -> Any:
     _symbolic(ctx, node, "change")
+    ctx = _variables_ctx(ctx)
     (x,) = _args(node, ctx, 1, "change")
     return _elementwise(H.change)(_leaf_arg(x, ctx, node, "change"))
 

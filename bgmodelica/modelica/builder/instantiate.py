@@ -106,7 +106,8 @@ def instantiate(view: ClassView, mods: dict[str, Mod], parent: Env | None, path:
         if m is not None and m.has_binding and sym.decl.kind != KIND_PARAMETER:
             bindings.append((sym, m, info))
     if bindings:
-        _declaration_equations(inst, bindings, connector)
+        owner = parent.inst if parent is not None else None
+        _declaration_equations(inst, bindings, connector, owner)
     if not view.validated:
         # evaluate the equations of the first instance of each class now, so that unknown
         # names, bad calls and wrong connects are reported when the model is loaded
@@ -207,15 +208,20 @@ def _join(path: str, name: str) -> str:
 
 
 def _add_child(inst: Element, name: str, child: Element, info: ElemInfo) -> None:
-    if name.isidentifier():
+    if name.isidentifier() and not hasattr(type(inst), name):
         try:
             inst.add(name, child)
         except ModelError as err:
             raise fail(info.lex, info.comp, str(err)) from None
         return
+    # an array element (R[1]) or a Modelica name that a Component method has (add): kept in
+    # the children only (Modelica references find it there); no attribute hides the method
+    if name in inst._children or name in inst._symbols:
+        raise fail(info.lex, info.comp, f"{name!r} is declared twice")
     object.__setattr__(child, "_name", name)
     inst._children[name] = child
-    object.__setattr__(inst, name, child)
+    if not hasattr(type(inst), name):
+        object.__setattr__(inst, name, child)
 
 
 def _make_class(view: ClassView, decls: dict[str, Any], connector: bool) -> type:
