@@ -73,7 +73,7 @@ class OptimalControl:
             "resimulation_error": self.resimulation_error,
             "final": self.final_values(),
             "solver": {"name": "ipopt", "method": "Radau IIA collocation (3 points), "
-                       "piecewise-constant controls", "status": sol.status,
+                       "piecewise-linear controls", "status": sol.status,
                        "iterations": sol.iterations, "intervals": len(sol.trajectory.mesh) - 1,
                        "refinements": len(self.history) - 1, "history": self.history,
                        "seconds": self.seconds},
@@ -85,32 +85,39 @@ class OptimalControl:
         return self.resimulation.to_csv(path)
 
     def plot(self, path: str | Path | None = None) -> Any:
-        """States (optimal: markers, re-simulated: lines) and controls against time."""
+        """States by unit (re-simulated: lines, optimal at the mesh points: dots) and controls
+        against time; saved to ``path`` if given. Returns the figure."""
         import matplotlib
 
         if path is not None:
             matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
-        from ..plotting import PAPER_STYLE
+        from ..plotting import PAPER_STYLE, group_by_unit
 
         res = self.resimulation
         states = self.states
+        groups = group_by_unit(res, list(states))
+        units = {u.name: u.decl.unit for u in self.problem.dae.inputs}
         with plt.rc_context(PAPER_STYLE):
-            fig, (ax_x, ax_u) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.2))
-            for name, (t, v) in states.items():
-                line, = ax_x.plot(res.time, res[name], label=name)
-                ax_x.plot(t[::3], v[::3], ".", color=line.get_color(), markersize=3)
-            ax_x.set_ylabel("states")
-            ax_x.legend(loc="best", ncol=2)
+            fig, axes = plt.subplots(len(groups) + 1, 1, sharex=True,
+                                     figsize=(6.4, 1.9 * (len(groups) + 1)))
+            for ax, (unit, names) in zip(axes, groups, strict=False):
+                for name in names:
+                    t, v = states[name]
+                    line, = ax.plot(res.time, res[name], label=name)
+                    ax.plot(t[::3], v[::3], ".", color=line.get_color(), markersize=2.5)
+                ax.set_ylabel(f"[{unit}]" if unit else "[-]")
+                ax.legend(loc="best", ncol=2)
+            ax_u = axes[-1]
             for name, (t, v) in self.controls.items():
                 ax_u.plot(t, v, label=name)
-            unit = res.unit(self.problem.controls[0]) if self.problem.controls[0] in res else ""
+            unit = units.get(self.problem.controls[0], "")
             ax_u.set_ylabel(f"controls [{unit}]" if unit else "controls")
             ax_u.set_xlabel("time [s]")
             ax_u.legend(loc="best")
-            ax_x.set_title(f"{self.problem.compiled.name}: objective {self.objective:.6g}, "
-                           f"T = {self.stop_time:.6g} s")
+            axes[0].set_title(f"{self.problem.compiled.name}: objective "
+                              f"{self.objective:.6g}, T = {self.stop_time:.6g} s")
             if path is not None:
                 fig.savefig(path)
                 plt.close(fig)
