@@ -78,6 +78,10 @@ from .analysis import linearize, steady_state  # noqa: E402
 
 __all__ += ["linearize", "steady_state"]
 
+from .optimal import optimize  # noqa: E402
+
+__all__ += ["optimize"]
+
 from .studies import fit, sweep  # noqa: E402  (Dask and xarray load only when a study runs)
 
 __all__ += ["sweep", "fit"]

@@ -369,6 +369,10 @@ from .modelica.cli import register as register_modelica  # noqa: E402
 
 _EXTENSIONS.append(register_modelica)
 
+from .optimal.cli import register as register_optimal  # noqa: E402
+
+_EXTENSIONS.append(register_optimal)
+
 
 def _autocomplete(parser: argparse.ArgumentParser) -> None:
     from .cli_tools import autocomplete
@@ -392,7 +396,7 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
 
 #: commands whose stderr (solver chatter, warnings) is held back and shown only on success,
 #: so that an error is the one line on stderr
-_HOLD_STDERR = {"simulate", "check", "export", "draw", "linearize", "export-mo"}
+_HOLD_STDERR = {"simulate", "check", "export", "draw", "linearize", "export-mo", "optimize"}
 
 
 def _error_line(err: BaseException) -> str:

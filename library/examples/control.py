@@ -3,11 +3,11 @@ top-level ``Input``s and ``Output``s, linearized by ``bgmodelica linearize``."""
 
 from __future__ import annotations
 
-from bgmodelica import Component, Input, Output, Parameter, connect
+from bgmodelica import Component, Input, Output, Parameter, Variable, connect, der
 from library.electrical import EMF, Ground, Inductor, Resistor, SignalVoltage
 from library.rotational import Damper, Fixed, Inertia, SpeedSensor
 
-__all__ = ["DCMotorIO"]
+__all__ = ["DCMotorIO", "DoubleIntegrator"]
 
 
 class DCMotorIO(Component):
@@ -53,3 +53,20 @@ class DCMotorIO(Component):
         yield connect(self.damper.flange_b, self.fixed.flange)
         yield connect(self.rotor.flange_b, self.sensor.flange)
         yield self.w == self.sensor.w
+
+
+class DoubleIntegrator(Component):
+    """A unit mass pushed by a force: the textbook optimal-control plant.
+
+    Input ``u`` [m/s2] (acceleration); states ``x`` [m] (position) and ``v`` [m/s] (speed),
+    ``der(x) = v``, ``der(v) = u``; starts at rest at 0. Moving it from rest at 0 to rest at
+    1 m in minimum time with ``|u| <= 1`` takes 2 s (bang-bang, switching at 1 s).
+    """
+
+    u = Input(unit="m/s2", description="Acceleration")
+    x = Variable(0.0, unit="m", description="Position", fixed=True)
+    v = Variable(0.0, unit="m/s", description="Speed", fixed=True)
+
+    def equations(self):
+        yield der(self.x) == self.v
+        yield der(self.v) == self.u
