@@ -132,7 +132,8 @@ def is_boolean(e: Any) -> bool:
     """Whether ``e`` is a Boolean-valued expression (relation, logic, Boolean variable,
     ``initial()``, ``sample()``)."""
     if isinstance(e, Leaf):
-        return isinstance(e.sym, Symbol) and isinstance(e.sym.decl, Boolean)
+        return isinstance(e.sym, Symbol) and (
+            isinstance(e.sym.decl, Boolean) or getattr(e.sym.decl, "type_name", "") == "Boolean")
     if isinstance(e, Op):
         if e.op in BOOLEAN_OPS:
             return True

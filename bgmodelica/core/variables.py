@@ -143,6 +143,34 @@ class Output(Variable):
 
 
 @dataclass(frozen=True)
+class BooleanInput(Input):
+    """A Boolean signal input (0/1), e.g. Modelica's ``BooleanInput``."""
+
+    type_name = "Boolean"
+
+
+@dataclass(frozen=True)
+class BooleanOutput(Output):
+    """A Boolean signal output (0/1)."""
+
+    type_name = "Boolean"
+
+
+@dataclass(frozen=True)
+class IntegerInput(Input):
+    """An Integer signal input."""
+
+    type_name = "Integer"
+
+
+@dataclass(frozen=True)
+class IntegerOutput(Output):
+    """An Integer signal output."""
+
+    type_name = "Integer"
+
+
+@dataclass(frozen=True)
 class Discrete(Variable):
     """A discrete-time Real: constant between events, changed only at event instants.
 

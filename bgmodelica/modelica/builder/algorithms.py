@@ -438,6 +438,24 @@ def _call_statement(st: A.StmtCall, ctx: Ctx) -> None:
     evaluate(call, ctx)
 
 
+def _c_value(v: Any) -> Any:
+    """An argument as the native implementations take it: enumerations as their index,
+    numeric arrays as numpy arrays."""
+    import numpy as np
+
+    if isinstance(v, S.EnumValue):
+        return v.index
+    if isinstance(v, list):
+        items = [_c_value(x) for x in v]
+        if not _symbolic(items) and not any(isinstance(x, str) for x in items):
+            try:
+                return np.asarray(items, dtype=float)
+            except (TypeError, ValueError):
+                return items
+        return items
+    return v
+
+
 def _external(fn: FunctionDef, local: dict, ctx: Ctx, node: Any) -> None:
     from .evaluate import evaluate
 
@@ -466,6 +484,7 @@ def _external(fn: FunctionDef, local: dict, ctx: Ctx, node: Any) -> None:
         for a in arg_nodes:
             if isinstance(a, A.Ref) and len(a.parts) == 1 and a.parts[0][0] in outputs:
                 out_names.append(a.parts[0][0])
+    args = [_c_value(a) for a in args]
     try:
         got = impl(*args)
     except NotConstant:

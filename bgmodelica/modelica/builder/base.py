@@ -50,7 +50,9 @@ def _where(lex: S.ClassScope | None, pos: A.Pos) -> str:
 
 
 def fail(lex: S.ClassScope | None, node: Any, message: str) -> ModelicaError:
-    pos = getattr(node, "pos", (0, 0)) if not isinstance(node, tuple) else node
+    pos = getattr(node, "pos", None)
+    if pos is None:
+        pos = node if isinstance(node, tuple) and len(node) == 2 else (0, 0)
     return ModelicaError(f"{_where(lex, pos)}: {message}")
 
 
@@ -116,6 +118,8 @@ def numeric_value(v: Any, lex: Any = None, node: Any = None) -> Any:
         return fn(*args)
     if isinstance(v, Element):
         raise NotConstant(f"component {v.name}")
+    if not isinstance(v, Expr) and getattr(v, "external_object", False):
+        return v                    # a table or other ExternalObject made when built
     raise NotConstant(repr(v))
 
 

@@ -10,10 +10,14 @@ from ...core.component import Element
 from ...core.variables import (
     KIND_PARAMETER,
     Boolean,
+    BooleanInput,
+    BooleanOutput,
     Discrete,
     Flow,
     Input,
     Integer,
+    IntegerInput,
+    IntegerOutput,
     Output,
     Parameter,
     Potential,
@@ -90,10 +94,16 @@ def _make_decl(info: ElemInfo, tref: TypeRef, attrs: dict, value: Any, connector
         return Flow(**kw)
     if "flow" in pre:
         raise fail(lex, comp, f"{comp.name}: flow variables belong in connectors")
-    if "input" in pre:
-        return Input(**kw)
-    if "output" in pre:
-        return Output(**kw)
+    if "input" in pre or "output" in pre:
+        if tref.base in ("Boolean", "Integer", "enum"):
+            kw.pop("unit")
+            kw.pop("nominal", None)
+            kw.pop("state_select", None)
+            boolean = tref.base == "Boolean"
+            if "input" in pre:
+                return BooleanInput(**kw) if boolean else IntegerInput(**kw)
+            return BooleanOutput(**kw) if boolean else IntegerOutput(**kw)
+        return Input(**kw) if "input" in pre else Output(**kw)
     if connector:
         return Potential(**kw)
     if tref.base == "Boolean":

@@ -88,7 +88,9 @@ def _category(info: ElemInfo, tref: TypeRef) -> str:
     if info.category:
         return info.category
     pre = info.comp.prefixes
-    if tref.kind != "scalar":
+    if tref.kind == "class" and _external_object(tref.scope):
+        cat = "const"             # an ExternalObject (a table): a value made when built
+    elif tref.kind != "scalar":
         cat = "child"
     elif "constant" in pre:
         cat = "const"
@@ -100,6 +102,12 @@ def _category(info: ElemInfo, tref: TypeRef) -> str:
         cat = "var"
     info.category = cat
     return cat
+
+
+def _external_object(scope: Any) -> bool:
+    """Whether class ``scope`` is an ExternalObject (it has a constructor function)."""
+    ctor = getattr(scope, "nested", lambda _: None)("constructor")
+    return ctor is not None and ctor.cdef.kind.endswith("function")
 
 
 def _dims(info: ElemInfo, env: Env | None, numeric: bool = True) -> tuple[int, ...]:

@@ -134,7 +134,26 @@ def _connect(a: Any, b: Any, ctx: Ctx, node: Any, out: list) -> None:
         for x, y in zip(a, b, strict=True):
             _connect(x, y, ctx, node, out)
         return
+    own = _own_output(a, ctx), _own_output(b, ctx)
+    if own[0] is not None and own[1] is not None and own[0] != own[1]:
+        # an inside output connected to this block's own output (an outside connector):
+        # the outside one takes the inside one's value
+        outer, inner = (a, b) if own[0] else (b, a)
+        out.append(Equation(outer, inner))
+        return
     out.append(connect(a, b))
+
+
+def _own_output(x: Any, ctx: Ctx) -> bool | None:
+    """None unless ``x`` is an output signal; then whether this instance declares it."""
+    from ...core.variables import KIND_OUTPUT
+
+    sym = getattr(x, "sym", None) if isinstance(x, Expr) else None
+    decl = getattr(sym, "decl", None)
+    if decl is None or decl.kind != KIND_OUTPUT:
+        return None
+    inst = ctx.env.inst if ctx.env is not None else None
+    return inst is not None and getattr(sym, "owner", None) is inst
 
 
 def _eval_if_equation(eq: A.EqIf, ctx: Ctx, out: list, initial: bool) -> None:

@@ -70,9 +70,13 @@ def _ev_ref(node: A.Ref, ctx: Ctx) -> Any:
     if name in ctx.loops:
         val = ctx.loops[name]
     elif env is None and len(parts) == 1:
-        # static evaluation (no instance): only literals and dotted constants / enumeration
-        # literals are known; a bare name may be an element of the instance
-        raise NotConstant(name)
+        # static evaluation (no instance): literals, constants and enumeration literals
+        # found lexically (a function's imports) are known; any other bare name may be an
+        # element of the instance
+        found = S.lookup(ctx.lex, name) if ctx.lex is not None else None
+        if not _is_value(found):
+            raise NotConstant(name)
+        val = _lexical_value(found, ctx, node)
     elif env is not None and name in env.view.elements:
         val = _env_member(env, name, ctx, node)
     elif env is not None and env.inst is not None and (

@@ -72,6 +72,7 @@ class _Table:
     """Matrix, columns and one :class:`Curve` per selected column."""
 
     kind = "table"
+    external_object = True        # a value made when the model is built, never a variable
 
     def __init__(self, file_name: str, table_name: str, table: Any, columns: Any,
                  smoothness: int, extrapolation: int, delimiter: str = ",",
