@@ -127,3 +127,14 @@ def test_pendulum_tight_tolerance():
 def test_static_choice_that_degenerates_is_an_error():
     with pytest.raises(SimulationError, match="degenerates at t = 0.58"):
         bg.simulate(Pendulum(), stop_time=5.0, interval=0.01, dynamic=False)
+
+
+@pytest.mark.parametrize(("cls", "stop", "interval"), [(Pendulum, 5.0, 0.001),
+                                                       (DoublePendulum, 1.0, 0.002)])
+def test_every_output_time_once_across_state_switches(cls, stop, interval):
+    # the switches fall on output times (t = 2.855 s, 3.735 s for the pendulum): none is lost
+    res = bg.simulate(cls(), stop_time=stop, interval=interval)
+    assert res.meta["state_switches"]
+    n = int(round(stop / interval)) + 1
+    assert len(res.time) == n
+    np.testing.assert_allclose(res.time, np.linspace(0.0, stop, n), rtol=0, atol=1e-12)
