@@ -109,6 +109,7 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         self._time_next = math.inf
         self._time_cause = ""
         self.recent: deque[tuple[float, str]] = deque(maxlen=self.opts.zeno_events)
+        self.init_notes: list[str] = []           # of the initial conditions
 
     # -- public -----------------------------------------------------------------------------
     def run(self, grid: np.ndarray, progress=None) -> tuple[np.ndarray, np.ndarray, str | None]:
@@ -351,6 +352,8 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         dae = self.dae
         if x is None:
             init = initialize(dae, self.p, t)
+            if not self.init_notes:
+                self.init_notes = list(init.notes)
             return init.x0, init.z0
         if fixed:
             d = replace(dae, x_start=np.asarray(x, dtype=float), fixed=fixed,
