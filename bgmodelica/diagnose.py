@@ -216,10 +216,11 @@ def check_initial_point(dae: Any, x0: Any, z0: Any, p: Any, t0: float) -> None:
         ode, alg, obs = (np.asarray(v, dtype=float).ravel()
                          for v in f(t0, x0 if dae.x.numel() else np.zeros(0),
                                     z0 if dae.z.numel() else np.zeros(0), p))
-    if np.all(np.isfinite(ode)) and np.all(np.isfinite(alg)) and np.all(np.isfinite(obs)):
-        return
     n_var = getattr(dae, "n_variables", 0) or len(dae.names)
     values = {n: float(v) for n, v in zip(dae.names[:n_var], obs, strict=False)}
+    if np.all(np.isfinite(ode)) and np.all(np.isfinite(alg)) and np.all(np.isfinite(obs)):
+        _check_residuals(dae, values, p, t0)
+        return
     why = explain(dae, values, p, t0)
     if not why:
         bad = [dae.names[k] for k in np.flatnonzero(~np.isfinite(obs))][:5] \
@@ -229,6 +230,52 @@ def check_initial_point(dae: Any, x0: Any, z0: Any, p: Any, t0: float) -> None:
         why = f"{', '.join(bad) or 'the model'} not finite at t = {t0:g} s"
     raise InitializationError(f"the model is undefined at the initial point: {why}; check the "
                               "parameter and start values")
+
+
+def _check_residuals(dae: Any, values: dict[str, float], p: Any, t0: float) -> None:
+    """Every equation defined at a finite initial point: a solved form can hide an undefined
+    one (``e1 = m*e2`` with ``m = l1/0`` gives ``e2 = e1/m = 0``)."""
+    srt = getattr(dae, "sorted", None)
+    if srt is None:
+        return
+    pt = _Point(dae, values, p, t0)
+    f = dae.cache.get("bgm_residuals")
+    if f is None:
+        known = {s.element_hash() for s in pt.syms}
+        rows = [k for k, e in enumerate(srt.model.equations)
+                if all(s.element_hash() in known for s in ca.symvar(e.residual))]
+        out = ca.vertcat(*[srt.model.equations[k].residual for k in rows]) if rows \
+            else ca.SX(0, 1)
+        f = dae.cache["bgm_residuals"] = (ca.Function("bgm_res", [pt.X], [out]), rows)
+    fn, rows = f
+    with np.errstate(all="ignore"):
+        res = np.asarray(fn(pt.vals), dtype=float).ravel()
+    if np.all(np.isfinite(res)):
+        return
+    k = rows[int(np.flatnonzero(~np.isfinite(res))[0])]
+    op = _operation(pt, srt.model.equations[k].residual) or _constant(
+        srt.model.equations[k].residual)
+    raise InitializationError(
+        f"the model is undefined at the initial point: equation {srt.model.describe(k)} is "
+        f"{_kind(float(res[rows.index(k)]))} at t = {t0:g} s" + (f" ({op})" if op else "")
+        + "; check the parameter and start values")
+
+
+def _constant(e: ca.SX) -> str:
+    """A non-finite constant of ``e`` (what a parameter expression such as ``l1/0`` folds
+    to), as text; "" when there is none."""
+    stack, seen = [e], 0
+    while stack and seen < 2000:
+        node = stack.pop()
+        seen += 1
+        if node.is_constant():
+            v = float(ca.DM(node))
+            if not math.isfinite(v):
+                return (f"a term is the constant {v}: a modulus or parameter expression of "
+                        "this element is not finite")
+        elif not node.is_leaf():
+            stack.extend(node.dep(i) for i in range(node.n_dep()))
+    return ""
 
 
 def check_result(result: Any, dae: Any, p: Any) -> None:

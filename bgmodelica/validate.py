@@ -269,6 +269,10 @@ def check_output_file(path: str | Path, option: str = "-o") -> Path:
     path = Path(path)
     if str(path) == "" or path.name in ("", ".", ".."):
         raise OptionError(f"{option} {str(path)!r}: not a file name")
+    if len(os.fsencode(path.name)) > 255:          # the usual NAME_MAX of file systems
+        short = path.name[:40] + "..." + path.name[-8:]
+        raise OptionError(f"{option} {short}: file name too long ({len(os.fsencode(path.name))}"
+                          " bytes, at most 255); give a shorter one with -o FILE")
     if path.is_dir():
         raise OptionError(f"{option} {path}: is an existing directory, not a file")
     if path.exists() and not path.is_file():
@@ -462,6 +466,36 @@ def check_binding(name: str, value: Any, leaves: list, full: dict[int, str]) -> 
                 f"parameter {name} is bound to {value!r}, which depends on the {decl.kind} "
                 f"{what}: a parameter is constant during a run; bind it to parameters only, "
                 "or declare it as a Variable with an equation")
+
+
+def check_binding_cycles(bindings: dict[str, list[str]]) -> None:
+    """Refuse parameter bindings that depend on themselves (``a = b``, ``b = a``), naming the
+    cycle. ``bindings``: parameter -> the parameters its binding uses."""
+    state: dict[str, int] = {}                    # 1: on the current path, 2: done
+    for root in bindings:
+        if state.get(root):
+            continue
+        path: list[str] = []
+        stack: list[tuple[str, int]] = [(root, 0)]
+        while stack:
+            node, k = stack.pop()
+            if k == 0:
+                state[node] = 1
+                path.append(node)
+            deps = bindings.get(node, [])
+            if k < len(deps):
+                stack.append((node, k + 1))
+                nxt = deps[k]
+                if state.get(nxt) == 1:
+                    cycle = path[path.index(nxt):] + [nxt]
+                    raise DeclarationError(
+                        "parameter bindings form a cycle: " + " -> ".join(cycle) + " (each "
+                        "is bound to an expression of the next); bind one of them to a value")
+                if not state.get(nxt):
+                    stack.append((nxt, 0))
+            else:
+                state[node] = 2
+                path.pop()
 
 
 def check_sx_binding(name: str, value: Any) -> None:

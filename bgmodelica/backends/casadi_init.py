@@ -3,8 +3,9 @@
 Fixed start values are hard conditions, every other start value is a guess. A fixed state
 gives its value directly; a fixed non-state (e.g. a variable demoted by index reduction) is a
 condition on the states through the observation map. Free states without a condition keep
-their start values (reported in ``notes``); conditions that over-determine the states raise
-:class:`InitializationError` with their names.
+their start values (reported in ``notes``); conditions that over-determine the states are
+accepted when the solution of the others satisfies them (a note: the pendulum released at
+x = 0, y = -1), and raise :class:`InitializationError` with their names otherwise.
 """
 
 from __future__ import annotations
@@ -32,20 +33,29 @@ class InitStructure:
 
     x0: start values with the fixed states set; free: indices of the states solved together
     with z from ``conditions`` ``(observed index, value)`` and the model's ``n_initial``
-    initial equations (``dae.initial``); notes: states left at their start values."""
+    initial equations (``dae.initial``, rows ``initial_rows``; all when None); notes:
+    states left at their start values; surplus: conditions beyond those that determine the
+    states (residual expression, label, value), to hold at the solution (else ``surplus_error``)."""
 
     x0: np.ndarray
     free: list[int]
     conditions: list[tuple[int, float]]
     notes: list[str]
     n_initial: int = 0
+    initial_rows: list[int] | None = None
+    surplus: list[tuple[ca.SX, str, float]] = field(default_factory=list)
+    surplus_error: str = ""
+
+    def rows(self) -> list[int]:
+        """The initial equations used to solve for the states."""
+        return list(range(self.n_initial)) if self.initial_rows is None else self.initial_rows
 
     def labels(self, dae: CasadiDAE) -> list[str]:
         """What each condition row is: a fixed start value or an initial equation."""
         out = [f"fixed start value {dae.names[k]} = {v:g}" for k, v in self.conditions]
         given = list(getattr(dae, "initial_labels", None) or [])
         return out + [given[i] if i < len(given) else f"initial equation {i}"
-                      for i in range(self.n_initial)]
+                      for i in self.rows()]
 
 
 def _n_initial(dae: CasadiDAE) -> int:
@@ -87,10 +97,15 @@ def init_structure(dae: CasadiDAE) -> InitStructure:
                                  + [[] for _ in exprs], nf + nz)
         match = maximum_matching(rows, nf + nz, initial=first)
         surplus = [i for i in range(len(exprs)) if match.eq_to_var[nz + i] < 0]
-        if surplus:
+        if surplus:          # kept aside: to hold at the solution of the others
             labelled = list(zip(exprs, st.labels(dae), strict=True))
-            raise InitializationError(_overdetermined(dae, labelled, surplus, rows, match,
-                                                      free, fixed_states))
+            st.surplus_error = _overdetermined(dae, labelled, surplus, rows, match, free,
+                                               fixed_states)
+            nc = len(conditions)
+            value = [conditions[i][1] if i < nc else 0.0 for i in range(len(exprs))]
+            st.surplus = [(exprs[i] - value[i], labelled[i][1], value[i]) for i in surplus]
+            st.conditions = [c for i, c in enumerate(conditions) if i not in surplus]
+            st.initial_rows = [i for i in range(n_init) if nc + i not in surplus]
         unmatched = [free[c] for c in range(nf) if match.var_to_eq[c] < 0]
     else:
         unmatched = list(free)
@@ -108,7 +123,7 @@ def _init_residual(dae: CasadiDAE, st: InitStructure) -> ca.Function:
     w = [x_free, z]."""
     unknown = ca.vertcat(*[dae.x[i] for i in st.free], dae.z)
     cond = [dae.observed[k] - v for k, v in st.conditions] \
-        + [dae.initial[i] for i in range(st.n_initial)]
+        + [dae.initial[i] for i in st.rows()]
     pinned = [i for i in range(len(st.x0)) if i not in set(st.free)]
     known = ca.vertcat(*[dae.x[i] for i in pinned]) if pinned else ca.SX(0, 1)
     return ca.Function("init_g", [unknown, ca.vertcat(known, dae.p, dae.t)],
@@ -122,7 +137,7 @@ def initial_state_function(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
     follow their parameters as native simulation does; None when the initial state is fixed
     (no conditions through the model's equations)."""
     st = init_structure(dae)
-    if not st.conditions and not st.n_initial:
+    if not st.conditions and not st.rows():
         return None
     sol = initialize(dae, p, t0)
     g = _init_residual(dae, st)
@@ -152,9 +167,9 @@ def initialize(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
     st = init_structure(dae)
     x0, free = st.x0, st.free
     z0 = dae.z_start.copy()
-    n_cond = len(st.conditions) + st.n_initial
+    n_cond = len(st.conditions) + len(st.rows())
     if not n_cond and dae.z.numel() == 0:
-        return InitialValues(x0, z0, list(st.notes))
+        return _surplus_checked(dae, st, p, t0, InitialValues(x0, z0, list(st.notes)))
     guess = np.concatenate([x0[free], z0])
     pinned = [i for i in range(len(x0)) if i not in set(free)]
     g = _init_residual(dae, st)
@@ -173,7 +188,7 @@ def initialize(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
                     else dae.algebraic_names[worst - n_cond])
             size = np.max(np.abs(r1)) if np.all(np.isfinite(r1)) else np.nan
             hint = ("; the initial equations or fixed start values may contradict each other "
-                    "or the model" if st.n_initial else "")
+                    "or the model" if st.rows() else "")
             raise InitializationError(
                 f"initialization did not converge: residual {size:.3g} at "
                 f"{what}; give better start values (guesses) for the algebraic variables"
@@ -181,7 +196,28 @@ def initialize(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
         guess = sol
     x0[free] = guess[:len(free)]
     z0 = guess[len(free):]
-    return InitialValues(x0, z0, list(st.notes))
+    return _surplus_checked(dae, st, p, t0, InitialValues(x0, z0, list(st.notes)))
+
+
+def _surplus_checked(dae: CasadiDAE, st: InitStructure, p: np.ndarray, t0: float,
+                     init: InitialValues) -> InitialValues:
+    """``init`` with a note when over-specifying conditions hold at it; raise
+    :class:`InitializationError` (the over-determined message) when one does not."""
+    if not st.surplus:
+        return init
+    f = ca.Function("init_surplus", [dae.x, dae.z, dae.p, dae.t],
+                    [ca.vertcat(*[e for e, _, _ in st.surplus])])
+    with np.errstate(all="ignore"):
+        r = np.asarray(f(init.x0, init.z0, p, t0), dtype=float).ravel()
+    scale = np.array([max(1.0, abs(v)) for _, _, v in st.surplus])
+    bad = ~(np.abs(r) <= 1e-6 * scale)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise InitializationError(f"{st.surplus_error} ({st.surplus[k][1]} is off by "
+                                  f"{r[k]:.3g} at the solution of the others)")
+    init.notes.append("; ".join(label for _, label, _ in st.surplus) + " over-specifies the "
+                      "initial state; it agrees with the other conditions and was accepted")
+    return init
 
 
 def _overdetermined(dae: CasadiDAE, conditions: list[tuple[ca.SX, str]], surplus: list[int],

@@ -16,7 +16,12 @@ import casadi as ca
 import numpy as np
 
 from ..errors import ConnectError, DeclarationError, EquationError
-from ..validate import check_binding, check_sx_binding, guarded_equations
+from ..validate import (
+    check_binding,
+    check_binding_cycles,
+    check_sx_binding,
+    guarded_equations,
+)
 from . import flatten_arrays, flatten_hybrid
 from .arrays import ArrayEquation
 from .component import Component, Connection, Connector, Element
@@ -41,6 +46,7 @@ from .variables import (
     TIME,
     Symbol,
     lookup,
+    start_text_error,
 )
 
 
@@ -111,11 +117,14 @@ class _Flattener(ConnectionLowering):
             self.pending, draft = flatten_hybrid.extract(self.pending, self.where)
             self.draft = None if draft.empty else draft
         variables, parameters, inputs, discretes, symbols = self._collect_symbols()
+        for fv in [v for v in variables if type(getattr(v.decl, "start", 0.0)) is str][:1]:
+            raise start_text_error(fv.name, fv.decl)
         self._bind(symbols)
         self._connection_equations()
         self._component_equations()
         initial = self._initial_equations()
         sources = self._sources(parameters)
+        self._check_cycles(parameters)
         parameters = [p if type(p.decl.value) is float else self._lower_binding(p)
                       for p in parameters]
         hybrid = None
@@ -324,6 +333,16 @@ class _Flattener(ConnectionLowering):
     def _rows(self, entries: list[int]) -> list[int]:
         """Rows in :attr:`all_sx` of the symbols at ``entries`` of the collected list."""
         return entries if self.rows is None else self.rows[entries].tolist()
+
+    def _check_cycles(self, parameters: list[FlatVariable]) -> None:
+        """Bindings that depend on themselves, named as a cycle."""
+        bound = [p for p in parameters if isinstance(p.decl.value, Expr)]
+        if not bound:
+            return
+        full = self.full
+        check_binding_cycles(
+            {p.name: [full.get(id(leaf), "?") for leaf in _leaf_symbols(p.decl.value)]
+             for p in bound})
 
     def _lower_binding(self, p: FlatVariable) -> FlatVariable:
         if isinstance(p.decl.value, Expr):

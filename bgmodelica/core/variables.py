@@ -102,13 +102,44 @@ class Variable(Declaration):
     state_select: StateSelect = StateSelect.DEFAULT
     kind = KIND_VARIABLE
 
+    def __post_init__(self) -> None:
+        if isinstance(self.start, str):
+            object.__setattr__(self, "start", _start_number(self.start, self.unit))
+
     def with_start(self, value: Any) -> Variable:
         if isinstance(value, dict):
             try:
                 return replace(self, **value)
             except TypeError as err:
                 raise DeclarationError(f"bad modifier {value!r}: {err}") from None
+        if isinstance(value, str):
+            value = _start_number(value, self.unit)
         return self.evolve(start=value, fixed=True)
+
+
+def _start_number(text: str, unit: str) -> float | str:
+    """A start value given as text: a number, or a quantity (``"0.5 V"``) converted to the
+    declared ``unit``; the text itself when it is neither (refused, with the variable's name,
+    by :func:`start_text_error` when the model is flattened)."""
+    from .units import quantity_value
+
+    try:
+        value = quantity_value("the start value", text, unit)
+    except ValueError:
+        return text
+    return text if isinstance(value, str) else float(value)
+
+
+def start_text_error(name: str, decl: Variable) -> DeclarationError:
+    """The error for a start value ``decl.start`` given as text that is not a number."""
+    from .units import quantity_value
+
+    try:
+        quantity_value(name, decl.start, decl.unit)
+    except ValueError as err:
+        return DeclarationError(f"start value of {name} = {decl.start!r}: {err}")
+    return DeclarationError(f"start value of {name} = {decl.start!r} is not a number (nor a "
+                            "number with a unit such as '0.5 V')")
 
 
 @dataclass(frozen=True)

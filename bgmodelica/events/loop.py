@@ -109,6 +109,7 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         self._time_next = math.inf
         self._time_cause = ""
         self.recent: deque[tuple[float, str]] = deque(maxlen=self.opts.zeno_events)
+        self.init_notes: list[str] = []           # of the initial conditions
 
     # -- public -----------------------------------------------------------------------------
     def run(self, grid: np.ndarray, progress=None) -> tuple[np.ndarray, np.ndarray, str | None]:
@@ -134,7 +135,7 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
             t_event, kind = self._next_time_event(t, stop)
             t_end = t_event
             if self.selection is not None:       # short stretches: a failure costs little
-                t_end = min(t_event, t + self.selection.stretch)
+                t_end = _snap(grid, k_out, min(t_event, t + self.selection.stretch))
             j = k_out
             while j < len(grid) and grid[j] < t_end:
                 j += 1
@@ -152,6 +153,9 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
                 next_report += 0.05
             if crossed == "select":
                 x, z = self._switch(t, x, z)
+                if k_out < len(grid) and grid[k_out] == t:    # the switch fell on an output
+                    record()
+                    k_out += 1
                 continue
             if crossed is None and kind is not None and t == t_event:
                 crossed = kind
@@ -196,9 +200,15 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
             return t1, xf, zf, None, []
         checks = self.opts.checks if fn.state_rel else 1
         if sel is not None:
-            checks = max(checks, int(math.ceil((t1 - t0) / sel.spacing)))
+            checks = max(checks, int(math.ceil((t1 - t0) / sel.spacing - 1e-9)))
         out_offsets = outs - t0
         uniform = (t1 - t0) * np.arange(1, checks + 1) / checks
+        if len(out_offsets):      # a check a rounding error from an output point is that point
+            i = np.searchsorted(out_offsets, uniform[:-1]).clip(1, len(outs) - 1)
+            pick = np.where(uniform[:-1] - out_offsets[i - 1] < out_offsets[i] - uniform[:-1],
+                            out_offsets[i - 1], out_offsets[i]) if len(outs) > 1 else out_offsets
+            close = np.abs(uniform[:-1] - pick) <= 1e-9 * (t1 - t0)
+            uniform[:-1] = np.where(close, pick, uniform[:-1])
         offsets = np.union1d(out_offsets, uniform)
         offsets = offsets[offsets > 0]
         try:
@@ -216,6 +226,9 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
             return self._advance(t0, t_short, x, z, outs[outs < t_short])
         nz = self.dae.z.numel()
         ts = t0 + offsets
+        out_cols = np.searchsorted(offsets, out_offsets)
+        inside = out_offsets > 0
+        ts[out_cols[inside]] = outs[inside]        # output times exactly as requested
         ts[-1] = t1
         last = len(offsets)
         crossing = None
@@ -240,7 +253,6 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
                             Z[:, stop_col] if nz else z, "select")
                 last = stop_col + 1
         passed = []
-        out_cols = np.searchsorted(offsets, out_offsets)
         for k, c in enumerate(out_cols):
             if c < last and out_offsets[k] > 0:
                 tk = float(outs[k])
@@ -340,6 +352,8 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         dae = self.dae
         if x is None:
             init = initialize(dae, self.p, t)
+            if not self.init_notes:
+                self.init_notes = list(init.notes)
             return init.x0, init.z0
         if fixed:
             d = replace(dae, x_start=np.asarray(x, dtype=float), fixed=fixed,
@@ -482,6 +496,15 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
 
     def _obs(self, t, x, z) -> np.ndarray:
         return self._step_fast(t, x, z, self.p)[6][self.obs_idx]
+
+
+def _snap(grid: np.ndarray, k: int, t: float) -> float:
+    """``t`` [s], or the output time ``grid[k:]`` within a rounding error of it."""
+    j = int(np.searchsorted(grid, t))
+    for i in (j - 1, j):
+        if k <= i < len(grid) and abs(grid[i] - t) <= 1e-12 * max(1.0, abs(t)) + 1e-15:
+            return float(grid[i])
+    return t
 
 
 def _count(items: list[str]) -> dict[str, int]:

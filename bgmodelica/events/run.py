@@ -48,7 +48,7 @@ def simulate_hybrid(compiled, dae: CasadiDAE, p: np.ndarray, grid: np.ndarray, *
             "timings": dict(compiled.timings), "solver": "cvodes" if not dae.z.numel()
             else "idas", "solver_choice": "auto",      # the event loop picks by structure
             "stats": dict(sim.stats), "states": list(dae.state_names),
-            "init_notes": [], **sim.meta}
+            "init_notes": list(sim.init_notes), **sim.meta}
     if selection is not None and selection.mode == "switch":
         meta["state_switches"] = list(selection.selector.switches)
         meta["states"] = list(dae.state_names)

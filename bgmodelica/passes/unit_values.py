@@ -23,8 +23,8 @@ class Adaptive:
         return self.name
 
 
-LIT = Adaptive("a number")          # a pure number: 1 in products, adapts in sums
-FREE = Adaptive("no unit")          # declared without unit: adapts everywhere, also in products
+LIT = Adaptive("a number")          # a literal: takes the unit its context needs
+FREE = Adaptive("no unit")          # undeclared, or a product with a literal factor: adapts
 
 
 class Known:
@@ -118,24 +118,21 @@ def dimensionless(a: Any, what: str) -> None:
 
 
 def mul(a: Any, b: Any) -> Any:
-    """The unit of ``a*b``."""
-    if a is FREE or b is FREE:
+    """The unit of ``a*b``; a literal factor may carry any unit (as in Modelica: ``3.0*time``
+    can be an angle), so a product with one adapts (FREE); two literals stay a literal."""
+    if a is LIT and b is LIT:
+        return LIT
+    if isinstance(a, Adaptive) or isinstance(b, Adaptive):
         return FREE
-    if a is LIT:
-        return b
-    if b is LIT:
-        return a
     return Known(_mul_text(a.text, b.text), a.unit * b.unit)
 
 
 def div(a: Any, b: Any) -> Any:
-    """The unit of ``a/b``."""
-    if a is FREE or b is FREE:
+    """The unit of ``a/b`` (a literal numerator or divisor adapts, as in :func:`mul`)."""
+    if a is LIT and b is LIT:
+        return LIT
+    if isinstance(a, Adaptive) or isinstance(b, Adaptive):
         return FREE
-    if b is LIT:
-        return a
-    if a is LIT:
-        a = DIMLESS
     return Known(_div_text(a.text, b.text), a.unit / b.unit)
 
 

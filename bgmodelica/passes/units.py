@@ -6,8 +6,10 @@ it meets, like a literal. The rules:
 
 - ``a + b``, ``a - b``, ``a == b`` (an equation), relations, ``fmin``/``fmax``, ``atan2(y, x)``
   and the two branches of ``if_else`` need the same unit (same dimensions *and* scale: values
-  are not converted, so ``km`` and ``m`` do not mix). A bare number takes the unit of what it
-  meets (``v == 0``, ``x + 1``); in a product it is a pure number.
+  are not converted, so ``km`` and ``m`` do not mix). A literal number takes the unit its
+  context needs, as in Modelica tools: in a sum the unit of the other terms (``v == 0``,
+  ``x + 1``); in a product or quotient it is a free factor, so the product adapts too
+  (``sin(3.0*time)``, ``exp(-time/5)``, ``2*v == i``). Products without literals stay checked.
 - ``*``, ``/`` multiply units; ``x**p`` with a literal ``p`` raises them to ``p``, ``sqrt``
   halves them; ``der(x)`` is ``unit(x)/s``; ``time`` is in s.
 - ``sin, cos, tan, exp, log, asin, acos, atan, sinh, cosh, tanh`` need a dimensionless

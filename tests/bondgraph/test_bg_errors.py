@@ -22,7 +22,7 @@ from bgmodelica.bondgraph import (
     Se,
     analyze,
 )
-from bgmodelica.errors import ModelError
+from bgmodelica.errors import InitializationError, ModelError
 
 
 def test_errors_are_model_errors():
@@ -136,3 +136,26 @@ def test_bad_law_and_graph_kind():
         bm.compile(bg)
     with pytest.raises(BondError, match="unknown bond-graph element kind"):
         Graph().add("x", "Q")
+
+
+def test_modulus_that_is_not_finite_is_refused():
+    # e1 = m e2 with m = l1/0 = inf: the solved form e2 = e1/m gave all-zero flows, silently
+    class Arm(BondGraph):
+        l1 = bm.Parameter(0.5)
+
+        def __init__(self, modulus, **kw):
+            super().__init__(**kw)
+            self.add("T", Se(E=1.0))
+            self.add("w", J1())
+            self.add("r", MTF(m=modulus))
+            self.add("v", J1())
+            self.add("m", I(I=1.0))
+            self.bond(self.T, self.w)
+            self.bond(self.w, self.r)
+            self.bond(self.r, self.v)
+            self.bond(self.v, self.m)
+
+    with pytest.raises(InitializationError, match=r"\[r \(MTF\)\] is NaN .*constant inf"):
+        bm.simulate(Arm("l1/0"), stop_time=1.0)
+    res = bm.simulate(Arm("l1"), stop_time=1.0)      # e2 = E/l1 = 2: p of the mass = 2 t
+    assert abs(res["m.p"][-1] - 2.0) < 1e-6

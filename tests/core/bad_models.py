@@ -387,3 +387,33 @@ class LosesSolution(Component):
     def equations(self):
         yield der(self.x) == 1.0
         yield self.z**2 + self.x**2 == 1.0
+
+
+class _Lag(Component):
+    T = Parameter(1.0)
+    U = Parameter(1.0)
+    x = Variable(start=1.0, fixed=True)
+
+    def equations(self):
+        yield der(self.x) == -self.x / self.T
+
+
+class RecursiveBindings(Component):
+    """c1.U bound to c2.T, c2.T bound to c1.U."""
+
+    def __init__(self, **kw):
+        super().__init__(**kw)
+        self.add("c1", _Lag())
+        self.add("c2", _Lag(T=self.c1.U))
+        self.c1.U = self.c2.T
+
+    def equations(self):
+        return ()
+
+
+class TextStart(Component):
+    x = Variable(start="half a volt", fixed=True, unit="V")
+    k = Parameter(1.0, unit="1/s")
+
+    def equations(self):
+        yield der(self.x) == -self.k * self.x

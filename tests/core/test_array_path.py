@@ -193,7 +193,7 @@ def test_an_unbalanced_model_gets_the_scalar_pipelines_error():
 class WrongUnits(DecayDeclarations):
     def equations(self):
         yield der(self.x) == -self.rate * self.x + self.u
-        yield self.y == 2.0 * self.rate                       # 1/s where m is declared
+        yield self.y == self.rate                             # 1/s where m is declared
         yield self.s == self.x[0] + self.x[-1]
 
 
@@ -238,10 +238,11 @@ class TwoUnits(Component):
     x = Variable(shape=2, unit="m")
     y = Variable(shape=2, unit="m")
     tau = Parameter(1.0, unit="s")
+    gain = Parameter(3.0, unit="1")
 
     def equations(self):
         yield der(self.x) == -self.x / self.tau
-        yield self.y == 3.0 * self.x
+        yield self.y == self.gain * self.x
 
 
 def test_an_array_of_several_units_is_checked_element_by_element():

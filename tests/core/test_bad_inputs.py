@@ -226,6 +226,12 @@ CASES = [
                  id="parameter-nan"),
     pytest.param(SIM + [_m("NanStart"), "-o", "{out}"], ("start value of C.v", "inf"),
                  id="start-inf"),
+    pytest.param(SIM + [_m("TextStart"), "-o", "{out}"],
+                 ("start value of x", "'half a volt'", "not a number"), id="start-text"),
+    pytest.param(SIM + [_m("RecursiveBindings"), "-o", "{out}"],
+                 ("cycle", "c1.U -> c2.T -> c1.U"), id="bindings-cycle"),
+    pytest.param(["export", _m("RecursiveBindings"), "-o", "{dir}/fmus"],
+                 ("cycle", "c1.U -> c2.T -> c1.U"), id="bindings-cycle-export"),
     pytest.param(SIM + [_m("RC"), "--set", "R.R=nan", "-o", "{out}"], ("R.R", "not finite"),
                  id="set-nan"),
     pytest.param(SIM + [_m("RC"), "--set", "R.R=inf", "-o", "{out}"], ("R.R", "not finite"),
@@ -517,3 +523,29 @@ def test_a_subclass_declaring_a_connector_under_a_variable_name_is_refused():
 
     with pytest.raises(DuplicateNameError, match="'p' already exists"):
         Sub()
+
+
+def test_start_value_with_a_unit_is_converted():
+    class Decay(bg.Component):
+        x = bg.Variable(start="500 mV", fixed=True, unit="V")
+        k = bg.Parameter(1.0, unit="1/s")
+
+        def equations(self):
+            yield bg.der(self.x) == -self.k * self.x
+
+    res = bg.simulate(Decay(), stop_time=1.0, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(res["x"], 0.5 * np.exp(-res.time), atol=1e-8)
+    res = bg.simulate(Decay(x="2 V"), stop_time=1.0, rtol=1e-10, atol=1e-12)
+    assert res["x"][0] == 2.0
+
+
+def test_model_name_too_long_for_a_file_name(capsys, tmp_path):
+    name = "M" + "a" * 300
+    path = tmp_path / "long.py"
+    path.write_text("from bgmodelica import Component, Variable, der\n\n"
+                    f"class {name}(Component):\n"
+                    "    x = Variable(start=1.0, fixed=True)\n\n"
+                    "    def equations(self):\n"
+                    "        yield der(self.x) == -self.x\n")
+    code, out, err = run(capsys, ["simulate", f"{path}:{name}"])
+    assert_one_line_error(code, out, err, ("file name too long", "-o FILE"))

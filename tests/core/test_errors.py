@@ -167,7 +167,7 @@ def test_conflicting_fixed_aliases():
 def test_overdetermined_initialization_names_variables():
     from library.examples.constrained import Pendulum
 
-    p = Pendulum(name="pend", x=1.0)          # x fixed as well as y: one too many
+    p = Pendulum(name="pend", x=0.5)          # x fixed as well as y, off the circle
     with pytest.raises(InitializationError) as err:
         bg.simulate(p, stop_time=0.1)
     assert "over-determined" in str(err.value)

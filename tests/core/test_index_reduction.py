@@ -127,3 +127,38 @@ def test_pendulum_tight_tolerance():
 def test_static_choice_that_degenerates_is_an_error():
     with pytest.raises(SimulationError, match="degenerates at t = 0.58"):
         bg.simulate(Pendulum(), stop_time=5.0, interval=0.01, dynamic=False)
+
+
+@pytest.mark.parametrize(("cls", "stop", "interval"), [(Pendulum, 5.0, 0.001),
+                                                       (DoublePendulum, 1.0, 0.002)])
+def test_every_output_time_once_across_state_switches(cls, stop, interval):
+    # the switches fall on output times (t = 2.855 s, 3.735 s for the pendulum): none is lost
+    res = bg.simulate(cls(), stop_time=stop, interval=interval)
+    assert res.meta["state_switches"]
+    n = int(round(stop / interval)) + 1
+    assert len(res.time) == n
+    np.testing.assert_allclose(res.time, np.linspace(0.0, stop, n), rtol=0, atol=1e-12)
+
+
+def test_consistent_over_specified_start_values_are_accepted():
+    # x and y both fixed on the circle: the rod constraint makes one of them redundant
+    res = bg.simulate(Pendulum(x={"start": 0.6, "fixed": True}, y={"start": -0.8, "fixed": True}),
+                      stop_time=2.0, interval=0.01, rtol=1e-9, atol=1e-10)
+    assert any("over-specifies" in n for n in res.meta["init_notes"])
+    ref = solve_ivp(lambda _t, s: [s[1], -G * np.sin(s[0])], (0.0, 2.0),
+                    [np.arctan2(0.6, 0.8), 0.0], method="DOP853", rtol=1e-12, atol=1e-12,
+                    t_eval=res.time)
+    np.testing.assert_allclose(res["x"], np.sin(ref.y[0]), atol=1e-5)
+    np.testing.assert_allclose(res["y"], -np.cos(ref.y[0]), atol=1e-5)
+    rest = bg.simulate(Pendulum(x={"start": 0.0, "fixed": True}, y={"start": -1.0, "fixed": True}),
+                       stop_time=1.0)
+    assert np.allclose(rest["y"], -1.0) and np.allclose(rest["x"], 0.0)
+
+
+def test_inconsistent_over_specified_start_values_are_refused():
+    from bgmodelica.errors import InitializationError
+
+    with pytest.raises(InitializationError, match=r"over-determined: fixed start value x = 0.5"
+                                                  r".*off by"):
+        bg.simulate(Pendulum(x={"start": 0.5, "fixed": True}, y={"start": -1.0, "fixed": True}),
+                    stop_time=1.0)

@@ -177,9 +177,38 @@ def test_literals_adapt_in_sums_and_are_numbers_in_products():
                 v=Variable(unit="V"), w=Variable(unit="V"), u=Variable(unit="V"),
                 p=Variable(unit="V"))
     assert _check(ok) == []
-    bad = _model(lambda s: s.y == 5e-5 * s.k, y=Variable(unit="kg.m2"), k=Variable(unit="1"))
+    no_literal = _model(lambda s: s.y == s.J * s.k, y=Variable(unit="kg.m2"),
+                        k=Variable(unit="1"), J=Parameter(1.0, unit="1"))
     with pytest.raises(UnitError, match="left side is kg.m2, right side is 1"):
-        _check(bad)
+        _check(no_literal)
+
+
+def test_literals_in_products_adapt_as_in_modelica():
+    # a literal factor takes the unit its context needs: 3.0 is in rad/s, 5 in s, 5e-5 in kg.m2
+    ok = _model(lambda s: der(s.q) == sin(3.0 * bg.time),
+                lambda s: s.y == bg.exp(-bg.time / 5),
+                lambda s: s.z == s.A * sin(2 * np.pi * s.f * bg.time),
+                lambda s: s.u == s.k * (s.w - 1),
+                lambda s: s.J == 5e-5 * s.y,
+                lambda s: s.G == 1 / s.R,
+                q=Variable(), y=Variable(unit="1"), z=Variable(unit="m"),
+                A=Parameter(1.0, unit="m"), f=Parameter(1.0, unit="Hz"), u=Variable(unit="V"),
+                k=Parameter(1.0, unit="V"), w=Variable(unit="1"), J=Variable(unit="kg.m2"),
+                G=Variable(unit="S"), R=Parameter(1.0, unit="Ohm"))
+    assert _check(ok) == []
+    # real mismatches are still refused, also next to an adapting literal product
+    cases = [
+        (lambda s: s.v == s.i + s.v, "cannot add A and V"),
+        (lambda s: s.v == 2 * s.v + s.i, "left side is V, right side is A"),
+        (lambda s: der(s.x) == s.c, r"der\(x\) == c: left side is m/s, right side is km/h"),
+        (lambda s: s.y == sin(bg.time), r"sin\(\) needs a dimensionless argument, got s"),
+        (lambda s: s.y == bg.exp(-bg.time / s.tau + s.x), r"cannot add s/s \(1\) and m"),
+    ]
+    for eq, message in cases:
+        bad = _model(eq, v=Variable(unit="V"), i=Variable(unit="A"), x=Variable(unit="m"),
+                     c=Variable(unit="km/h"), y=Variable(unit="1"), tau=Parameter(1.0, unit="s"))
+        with pytest.raises(UnitError, match=message):
+            _check(bad)
 
 
 def test_undeclared_unit_adapts():
@@ -252,7 +281,7 @@ def test_parameter_bindings_and_unknown_units():
 
         def __init__(self, **kw):
             super().__init__(**kw)
-            self.add("child", Child(T=self.L / 2))
+            self.add("child", Child(T=self.L))
 
         def equations(self):
             return ()
@@ -264,7 +293,7 @@ def test_parameter_bindings_and_unknown_units():
         def equations(self):
             yield self.x == self.T
 
-    with pytest.raises(UnitError, match=r"parameter child.T = \(L/2\): declared in s, bound to "
+    with pytest.raises(UnitError, match=r"parameter child.T = L: declared in s, bound to "
                                         "a value in m"):
         _check(Parent)
     unknown = _model(lambda s: s.x == 1.0, x=Variable(unit="blorf"))
