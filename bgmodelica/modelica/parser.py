@@ -17,6 +17,7 @@ from lark import Lark, Token, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, VisitError
 
 from . import ast as A
+from . import ast_cache
 from .errors import ModelicaError, ModelicaSyntaxError
 from .expression_rules import ident_text, node_pos, token_pos
 from .statement_rules import StatementRules
@@ -62,6 +63,7 @@ class _ToAst(StatementRules):
     def __init__(self, file: str) -> None:
         super().__init__()
         self.file = file
+        self.classes: list[A.ClassDef] = []     # every class definition made
 
     # -- stored definition -------------------------------------------------------------------
     def start(self, meta, ch):
@@ -96,6 +98,7 @@ class _ToAst(StatementRules):
         cdef.encapsulated = isinstance(ch[0], Token) and ch[0].type == "ENCAPSULATED"
         cdef.pos = node_pos(meta)
         cdef.file = self.file
+        self.classes.append(cdef)
         return cdef
 
     short_class_definition = class_definition
@@ -367,12 +370,18 @@ def _constrain(body: Any, rest: list) -> None:
 
 def parse_text(text: str, file: str = "<string>") -> A.StoredDefinition:
     """Parse Modelica ``text``; ``file`` names it in error messages."""
+    return _parse(text, file)[0]
+
+
+def _parse(text: str, file: str) -> tuple[A.StoredDefinition, list[A.ClassDef]]:
+    """The syntax tree of ``text`` and every class definition in it."""
     try:
         tree = _lark().parse(text)
     except UnexpectedInput as err:
         raise _syntax_error(err, text, file) from None
+    rules = _ToAst(file)
     try:
-        return _ToAst(file).transform(tree)
+        return rules.transform(tree), rules.classes
     except VisitError as err:
         if isinstance(err.orig_exc, ModelicaError):
             raise err.orig_exc from None
@@ -424,22 +433,30 @@ def _terminal_text(name: str) -> str:
 _CACHE: dict[str, tuple[tuple, A.StoredDefinition]] = {}
 
 
-def parse_file(path: str | os.PathLike) -> A.StoredDefinition:
-    """Parse a ``.mo`` file (cached while the file is unchanged)."""
+def parse_file(path: str | os.PathLike, disk_cache: bool = True) -> A.StoredDefinition:
+    """Parse a ``.mo`` file: cached in this process while the file is unchanged, and on disk
+    by content (:mod:`.ast_cache`) unless ``disk_cache`` is false."""
     p = Path(path)
     try:
         st = p.stat()
-        text = p.read_text(encoding="utf-8")
+        data = p.read_bytes()
+        text = data.decode("utf-8")
     except OSError as err:
         raise ModelicaError(f"cannot read Modelica file {p}: {err.strerror or err}") from None
     except UnicodeDecodeError as err:
         raise ModelicaError(f"Modelica file {p} is not UTF-8 text ({err.reason} at byte "
                             f"{err.start})") from None
     key = str(p.resolve())
-    stamp = (st.st_mtime_ns, st.st_size, hash(text))
+    stamp = (st.st_mtime_ns, st.st_size, hash(data), str(path))
     hit = _CACHE.get(key)
     if hit is not None and hit[0] == stamp:
         return hit[1]
-    tree = parse_text(text, str(path))
+    tree = ast_cache.load(data, str(path)) if disk_cache else None
+    if tree is None:
+        if "\r" in text:                  # newlines as read_text would give them
+            text = text.replace("\r\n", "\n").replace("\r", "\n")
+        tree, classes = _parse(text, str(path))
+        if disk_cache:
+            ast_cache.store(data, tree, classes)
     _CACHE[key] = (stamp, tree)
     return tree
