@@ -9,16 +9,18 @@ for classes and elements are here, those for equations and expressions in
 from __future__ import annotations
 
 import os
+import threading
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-from lark import Lark, Token, v_args
-from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, VisitError
+from lark import Lark, Token
+from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 
 from . import ast as A
+from . import ast_cache
 from .errors import ModelicaError, ModelicaSyntaxError
-from .expression_rules import ident_text, node_pos, token_pos
+from .expression_rules import first_pos, ident_text, token_pos
 from .statement_rules import StatementRules
 
 _GRAMMAR = Path(__file__).with_name("grammar.lark")
@@ -30,20 +32,11 @@ UNSUPPORTED_WORDS = {
 }
 
 
-@lru_cache(maxsize=1)
-def _lark() -> Lark:
-    # cache=True keeps the generated LALR tables in the temporary directory (keyed by the
-    # grammar's hash): building them takes ~0.4 s, loading them ~0.03 s
-    try:
-        return Lark(_GRAMMAR.read_text(), parser="lalr", propagate_positions=True,
-                    maybe_placeholders=False, cache=True)
-    except OSError:                       # read-only temporary directory
-        return Lark(_GRAMMAR.read_text(), parser="lalr", propagate_positions=True,
-                    maybe_placeholders=False)
-
-
 class _ClassMod(tuple):
-    """The argument list of a class modification (distinguished from other tuples)."""
+    """The argument list of a class modification (distinguished from other tuples); ``pos``
+    is its opening parenthesis."""
+
+    pos: A.Pos
 
 
 class _Section(tuple):
@@ -51,20 +44,31 @@ class _Section(tuple):
 
 
 class _Prefixes(tuple):
-    """``(partial, purity, kind)`` of a class definition."""
+    """``(partial, purity, kind)`` of a class definition; ``pos`` its first keyword."""
+
+    pos: A.Pos
+
+
+class _Name(str):
+    """A dotted name with the position ``pos`` of its first identifier."""
+
+    pos: A.Pos
 
 
 _PURITY = {"PURE": "pure", "IMPURE": "impure"}
 
 
-@v_args(meta=True)
 class _ToAst(StatementRules):
-    def __init__(self, file: str) -> None:
+    """The rules for classes and elements; ``file`` names the text being parsed and
+    ``classes`` collects every class definition made."""
+
+    def __init__(self) -> None:
         super().__init__()
-        self.file = file
+        self.file = "<string>"
+        self.classes: list[A.ClassDef] = []
 
     # -- stored definition -------------------------------------------------------------------
-    def start(self, meta, ch):
+    def start(self, ch):
         within = None
         classes = []
         for c in ch:
@@ -74,54 +78,60 @@ class _ToAst(StatementRules):
                 within = c
         return A.StoredDefinition(self.file, within, classes)
 
-    def within_clause(self, meta, ch):
-        return ch[0] if ch else ""
+    def within_clause(self, ch):
+        return str(ch[0]) if ch else ""
 
-    def name(self, meta, ch):
-        return ".".join(ident_text(t) for t in ch)
+    def name(self, ch):
+        out = _Name(".".join(ident_text(t) for t in ch))
+        out.pos = token_pos(ch[0])
+        return out
 
-    def type_specifier(self, meta, ch):
-        return ch[-1]
+    def type_specifier(self, ch):
+        return str(ch[-1])
 
     # -- classes -----------------------------------------------------------------------------
-    def class_prefixes(self, meta, ch):
+    def class_prefixes(self, ch):
         partial = bool(ch) and ch[0].type == "PARTIAL"
         purity = next((_PURITY[t.type] for t in ch if t.type in _PURITY), "")
         kind = " ".join(str(t) for t in ch if t.type != "PARTIAL" and t.type not in _PURITY)
-        return _Prefixes((partial, purity, kind))
+        out = _Prefixes((partial, purity, kind))
+        out.pos = token_pos(ch[0])
+        return out
 
-    def class_definition(self, meta, ch):
+    def class_definition(self, ch):
         cdef: A.ClassDef = ch[-1]
         cdef.partial, cdef.purity, cdef.kind = ch[-2]
         cdef.encapsulated = isinstance(ch[0], Token) and ch[0].type == "ENCAPSULATED"
-        cdef.pos = node_pos(meta)
+        cdef.pos = first_pos(ch)
         cdef.file = self.file
+        self.classes.append(cdef)
         return cdef
 
     short_class_definition = class_definition
 
-    def long_class_specifier(self, meta, ch):
+    def long_class_specifier(self, ch):
         name, desc, comp, end = ident_text(ch[0]), ch[1], ch[2], ident_text(ch[3])
         if name != end:
             raise ModelicaSyntaxError(self.file, ch[3].line, ch[3].column,
                                       f"class {name} is closed by 'end {end}' (expected "
                                       f"'end {name}')")
-        cdef = A.ClassDef(name, "", node_pos(meta), description=desc, file=self.file, **comp)
+        cdef = A.ClassDef(name, "", token_pos(ch[0]), description=desc, file=self.file, **comp)
         for el in cdef.elements:
             if isinstance(el, A.ClassDef):
                 el.parent = cdef
         return cdef
 
-    def extends_class_specifier(self, meta, ch):
-        mod = A.Modification((), None, node_pos(meta))
+    def extends_class_specifier(self, ch):
+        pos, ch = token_pos(ch[0]), ch[1:]
+        mod = A.Modification((), None, pos)
         if isinstance(ch[1], _ClassMod):
-            mod = A.Modification(tuple(ch[1]), None, node_pos(meta))
+            mod = A.Modification(tuple(ch[1]), None, pos)
             ch = [ch[0], *ch[2:]]
-        cdef = self.long_class_specifier(meta, ch)
+        cdef = self.long_class_specifier(ch)
         cdef.class_extends = mod
         return cdef
 
-    def short_class_specifier(self, meta, ch):
+    def short_class_specifier(self, ch):
         name = ident_text(ch[0])
         prefix = ch[1]
         type_name = ch[2]
@@ -132,13 +142,13 @@ class _ToAst(StatementRules):
             if isinstance(c, list):
                 dims = tuple(c)
             elif isinstance(c, _ClassMod):
-                mod = A.Modification(tuple(c), None, node_pos(meta))
+                mod = A.Modification(tuple(c), None, token_pos(ch[0]))
             elif isinstance(c, tuple) and len(c) == 2:
                 desc, ann = c
-        return A.ClassDef(name, "", node_pos(meta), description=desc, annotation=ann,
+        return A.ClassDef(name, "", token_pos(ch[0]), description=desc, annotation=ann,
                           short=(prefix, type_name, dims, mod), file=self.file)
 
-    def enum_class_specifier(self, meta, ch):
+    def enum_class_specifier(self, ch):
         name = ident_text(ch[0])
         literals: tuple = ()
         desc = ""
@@ -147,19 +157,19 @@ class _ToAst(StatementRules):
                 literals = tuple(c)
             elif isinstance(c, tuple) and len(c) == 2:
                 desc = c[0]
-        return A.ClassDef(name, "type", node_pos(meta), description=desc, enum=literals,
+        return A.ClassDef(name, "type", token_pos(ch[0]), description=desc, enum=literals,
                           file=self.file)
 
-    def base_prefix(self, meta, ch):
+    def base_prefix(self, ch):
         return str(ch[0]) if ch else ""
 
-    def enum_list(self, meta, ch):
+    def enum_list(self, ch):
         return list(ch)
 
-    def enumeration_literal(self, meta, ch):
+    def enumeration_literal(self, ch):
         return ident_text(ch[0])
 
-    def composition(self, meta, ch):
+    def composition(self, ch):
         out: dict[str, Any] = {"elements": [], "equations": [], "initial_equations": [],
                                "algorithms": [], "initial_algorithms": [], "annotation": None,
                                "external": None}
@@ -183,25 +193,25 @@ class _ToAst(StatementRules):
         out["protected"] = frozenset(protected)
         return out
 
-    def public_section(self, meta, ch):
+    def public_section(self, ch):
         return _Section(("elements", ch[0]))
 
-    def protected_section(self, meta, ch):
+    def protected_section(self, ch):
         return _Section(("protected", ch[0]))
 
-    def equation_section(self, meta, ch):
+    def equation_section(self, ch):
         return _Section(("equations", list(ch)))
 
-    def initial_equation_section(self, meta, ch):
+    def initial_equation_section(self, ch):
         return _Section(("initial_equations", list(ch[1:])))
 
-    def algorithm_section(self, meta, ch):
+    def algorithm_section(self, ch):
         return _Section(("algorithms", A.Statements(ch[1:], token_pos(ch[0]))))
 
-    def initial_algorithm_section(self, meta, ch):
+    def initial_algorithm_section(self, ch):
         return _Section(("initial_algorithms", A.Statements(ch[1:], token_pos(ch[0]))))
 
-    def element_list(self, meta, ch):
+    def element_list(self, ch):
         out = []
         for c in ch:
             if isinstance(c, list):
@@ -210,10 +220,10 @@ class _ToAst(StatementRules):
                 out.append(c)
         return out
 
-    def element_prefix(self, meta, ch):
+    def element_prefix(self, ch):
         return str(ch[0])
 
-    def declaration_element(self, meta, ch):
+    def declaration_element(self, ch):
         prefixes = frozenset(c for c in ch if isinstance(c, str) and not isinstance(c, Token)
                              and c in ("redeclare", "final", "inner", "outer", "replaceable"))
         k = next(i for i, c in enumerate(ch) if isinstance(c, (A.ClassDef, list)))
@@ -226,36 +236,36 @@ class _ToAst(StatementRules):
             comp.element_prefixes = prefixes
         return body
 
-    def constraining_clause(self, meta, ch):
+    def constraining_clause(self, ch):
         return ("constrainedby", ch[0], ch[1] if len(ch) > 1 else None)
 
-    def import_alias(self, meta, ch):
-        return A.Import(ident_text(ch[0]), ch[1], False, node_pos(meta))
+    def import_alias(self, ch):
+        return A.Import(ident_text(ch[1]), str(ch[2]), False, token_pos(ch[0]))
 
-    def import_all(self, meta, ch):
-        return A.Import(None, ch[0], True, node_pos(meta))
+    def import_all(self, ch):
+        return A.Import(None, str(ch[1]), True, token_pos(ch[0]))
 
-    def import_name(self, meta, ch):
-        return A.Import(None, ch[0], False, node_pos(meta))
+    def import_name(self, ch):
+        return A.Import(None, str(ch[1]), False, token_pos(ch[0]))
 
-    def import_some(self, meta, ch):
+    def import_some(self, ch):
         """``import A.B.{c, d}``: one import a name."""
-        return [A.Import(None, f"{ch[0]}.{name}", False, node_pos(meta)) for name in ch[2]]
+        return [A.Import(None, f"{ch[1]}.{name}", False, token_pos(ch[0])) for name in ch[3]]
 
-    def import_list(self, meta, ch):
+    def import_list(self, ch):
         return [ident_text(t) for t in ch]
 
-    def extends_clause(self, meta, ch):
+    def extends_clause(self, ch):
         mod = None
-        for c in ch[1:]:
+        for c in ch[2:]:
             if isinstance(c, _ClassMod):
-                mod = A.Modification(tuple(c), None, node_pos(meta))
-        return A.Extends(ch[0], mod, node_pos(meta))
+                mod = A.Modification(tuple(c), None, token_pos(ch[0]))
+        return A.Extends(ch[1], mod, token_pos(ch[0]))
 
-    def type_prefix(self, meta, ch):
+    def type_prefix(self, ch):
         return str(ch[0])
 
-    def component_clause(self, meta, ch):
+    def component_clause(self, ch):
         prefixes = []
         k = 0
         while isinstance(ch[k], str) and not isinstance(ch[k], Token) and ch[k] in (
@@ -274,14 +284,14 @@ class _ToAst(StatementRules):
                                      mod, cond, desc, ann, pos))
         return comps
 
-    def component_clause1(self, meta, ch):
-        comps = self.component_clause(meta, [*ch[:-1], _CompList([ch[-1]])])
+    def component_clause1(self, ch):
+        comps = self.component_clause([*ch[:-1], _CompList([ch[-1]])])
         return comps[0]
 
-    def component_list(self, meta, ch):
+    def component_list(self, ch):
         return _CompList(ch)
 
-    def component_declaration(self, meta, ch):
+    def component_declaration(self, ch):
         name, dims, mod, pos = ch[0]
         cond = None
         desc, ann = "", None
@@ -292,13 +302,13 @@ class _ToAst(StatementRules):
                 desc, ann = c
         return (name, dims, mod, cond, desc, ann, pos)
 
-    def component_declaration1(self, meta, ch):
-        return self.component_declaration(meta, ch)
+    def component_declaration1(self, ch):
+        return self.component_declaration(ch)
 
-    def condition_attribute(self, meta, ch):
+    def condition_attribute(self, ch):
         return ("__cond__", ch[0])
 
-    def declaration(self, meta, ch):
+    def declaration(self, ch):
         name = ident_text(ch[0])
         dims: tuple = ()
         mod = None
@@ -310,38 +320,35 @@ class _ToAst(StatementRules):
         return (name, dims, mod, token_pos(ch[0]))
 
     # -- modifications -----------------------------------------------------------------------
-    def modification(self, meta, ch):
-        args: tuple = ()
-        binding = None
-        for c in ch:
-            if isinstance(c, _ClassMod):
-                args = tuple(c)
-            else:
-                binding = c
-        return A.Modification(args, binding, node_pos(meta))
+    def modification(self, ch):
+        if isinstance(ch[0], Token):                # = expression, := expression
+            return A.Modification((), ch[1], token_pos(ch[0]))
+        return A.Modification(tuple(ch[0]), ch[1] if len(ch) > 1 else None, ch[0].pos)
 
-    def class_modification(self, meta, ch):
-        return _ClassMod(ch)
+    def class_modification(self, ch):
+        out = _ClassMod(ch[1:])
+        out.pos = token_pos(ch[0])
+        return out
 
-    def element_modification_or_replaceable(self, meta, ch):
+    def element_modification_or_replaceable(self, ch):
         target = ch[-1]
         flags = {str(t) for t in ch[:-1]}
         if isinstance(target, A.ElementMod):
             target.each = "each" in flags
             target.final = "final" in flags
             return target
-        return A.Redeclare(target, "each" in flags, node_pos(meta))
+        return A.Redeclare(target, "each" in flags, first_pos(ch))
 
-    def element_modification(self, meta, ch):
+    def element_modification(self, ch):
         name = ch[0]
         mod = next((c for c in ch[1:] if isinstance(c, A.Modification)), None)
-        return A.ElementMod(name, mod, pos=node_pos(meta))
+        return A.ElementMod(str(name), mod, pos=name.pos)
 
-    def element_redeclaration(self, meta, ch):
+    def element_redeclaration(self, ch):
         flags = {str(t) for t in ch[:-1]}
-        return A.Redeclare(ch[-1], "each" in flags, node_pos(meta))
+        return A.Redeclare(ch[-1], "each" in flags, first_pos(ch))
 
-    def element_replaceable(self, meta, ch):
+    def element_replaceable(self, ch):
         _constrain(ch[1], ch[2:])
         return ch[1]
 
@@ -367,16 +374,35 @@ def _constrain(body: Any, rest: list) -> None:
 
 def parse_text(text: str, file: str = "<string>") -> A.StoredDefinition:
     """Parse Modelica ``text``; ``file`` names it in error messages."""
+    return _parse(text, file)[0]
+
+
+@lru_cache(maxsize=1)
+def _lark() -> tuple[Lark, _ToAst]:
+    """The parser, with the rules of :class:`_ToAst` applied while parsing (no parse tree is
+    built, and lark's position tracking is not needed: nodes take their first token's)."""
+    rules = _ToAst()
+    options = dict(parser="lalr", transformer=rules, maybe_placeholders=False)
+    # cache=True keeps the generated LALR tables in the temporary directory (keyed by the
+    # grammar's hash): building them takes ~0.4 s, loading them ~0.03 s
     try:
-        tree = _lark().parse(text)
-    except UnexpectedInput as err:
-        raise _syntax_error(err, text, file) from None
-    try:
-        return _ToAst(file).transform(tree)
-    except VisitError as err:
-        if isinstance(err.orig_exc, ModelicaError):
-            raise err.orig_exc from None
-        raise
+        return Lark(_GRAMMAR.read_text(), cache=True, **options), rules
+    except OSError:                       # read-only temporary directory
+        return Lark(_GRAMMAR.read_text(), **options), rules
+
+
+_LOCK = threading.Lock()
+
+
+def _parse(text: str, file: str) -> tuple[A.StoredDefinition, list[A.ClassDef]]:
+    """The syntax tree of ``text`` and every class definition in it."""
+    lark, rules = _lark()
+    with _LOCK:                           # the rules hold the file being parsed
+        rules.file, rules.classes = file, []
+        try:
+            return lark.parse(text), rules.classes
+        except UnexpectedInput as err:
+            raise _syntax_error(err, text, file) from None
 
 
 def _syntax_error(err: UnexpectedInput, text: str, file: str) -> ModelicaSyntaxError:
@@ -424,22 +450,30 @@ def _terminal_text(name: str) -> str:
 _CACHE: dict[str, tuple[tuple, A.StoredDefinition]] = {}
 
 
-def parse_file(path: str | os.PathLike) -> A.StoredDefinition:
-    """Parse a ``.mo`` file (cached while the file is unchanged)."""
+def parse_file(path: str | os.PathLike, disk_cache: bool = True) -> A.StoredDefinition:
+    """Parse a ``.mo`` file: cached in this process while the file is unchanged, and on disk
+    by content (:mod:`.ast_cache`) unless ``disk_cache`` is false."""
     p = Path(path)
     try:
         st = p.stat()
-        text = p.read_text(encoding="utf-8")
+        data = p.read_bytes()
+        text = data.decode("utf-8")
     except OSError as err:
         raise ModelicaError(f"cannot read Modelica file {p}: {err.strerror or err}") from None
     except UnicodeDecodeError as err:
         raise ModelicaError(f"Modelica file {p} is not UTF-8 text ({err.reason} at byte "
                             f"{err.start})") from None
     key = str(p.resolve())
-    stamp = (st.st_mtime_ns, st.st_size, hash(text))
+    stamp = (st.st_mtime_ns, st.st_size, hash(data), str(path))
     hit = _CACHE.get(key)
     if hit is not None and hit[0] == stamp:
         return hit[1]
-    tree = parse_text(text, str(path))
+    tree = ast_cache.load(data, str(path)) if disk_cache else None
+    if tree is None:
+        if "\r" in text:                  # newlines as read_text would give them
+            text = text.replace("\r\n", "\n").replace("\r", "\n")
+        tree, classes = _parse(text, str(path))
+        if disk_cache:
+            ast_cache.store(data, tree, classes)
     _CACHE[key] = (stamp, tree)
     return tree
