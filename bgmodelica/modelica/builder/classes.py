@@ -145,8 +145,9 @@ def _inherit(view: ClassView, base: ClassView, ext_mod: Mod | None) -> None:
         new = ElemInfo(info.comp, info.lex, merge(outer, info.mod))
         if outer is not None and outer.redeclare is not None:
             el, lex = outer.redeclare
-            new = ElemInfo(el, lex, merge(_without_redeclare(outer), mod_from_ast(el.mod, SELF,
-                                                                                   lex)))
+            # the replaced declaration's modifiers still apply (under the new ones)
+            new = ElemInfo(el, lex, merge(_without_redeclare(outer),
+                                          merge(mod_from_ast(el.mod, SELF, lex), info.mod)))
         view.elements[name] = new
     if ext_mod is not None:
         for name, m in ext_mod.sub.items():

@@ -141,6 +141,9 @@ def _env_member(env: Env, name: str, ctx: Ctx, node: Any) -> Any:
         raise _Disabled(name)
     if cat in ("const", "string"):
         return env.numeric(name)
+    if cat == "param" and type_ref(info).base in ("Boolean", "Integer", "enum"):
+        return env.numeric(name)        # Boolean, Integer and enumeration parameters: fixed
+                                        # when the model is built (they size and select)
     if ctx.numeric:
         if cat == "param":
             return env.numeric(name)

@@ -149,8 +149,8 @@ def _plan(view: ClassView, env: Env, connector: bool) -> tuple:
         m = env.mods.get(name)
         if m is not None and m.redeclare is not None:
             el, lex = m.redeclare
-            info = ElemInfo(el, lex, merge(_without_redeclare(m), mod_from_ast(el.mod, SELF,
-                                                                                 lex)))
+            info = ElemInfo(el, lex, merge(_without_redeclare(m),
+                                           merge(mod_from_ast(el.mod, SELF, lex), info.mod)))
             cacheable = False
             env.view = view = _with_element(view, name, info, env)
             env.mods = {k: v for k, v in env.mods.items() if k != name}
