@@ -410,6 +410,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     parser = build_parser()
     _autocomplete(parser)
+    if not (sys.argv[1:] if argv is None else list(argv)):     # alone: the commands
+        parser.print_help()
+        return 0
     try:
         args = parser.parse_args(argv)
     except SystemExit as done:            # usage error (one line) or --help

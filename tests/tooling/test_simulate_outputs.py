@@ -47,3 +47,16 @@ def test_bulk_csv_matches_the_csv_module(tmp_path):
     expected = np.column_stack([res.time] + [res[n] for n in res.all_names()])
     np.testing.assert_array_equal(table, np.array([[float(f"{v:.12g}") for v in r]
                                                    for r in expected]))
+
+
+def test_bgmodelica_alone_prints_the_commands(capsys):
+    assert main([]) == 0
+    out = capsys.readouterr().out
+    assert "simulate" in out and "export" in out and "check" in out
+
+
+def test_result_repr_is_one_short_line():
+    res = bg.simulate(RCLadder(200), stop_time=2.0)
+    text = repr(res)
+    assert text == f"Result(RCLadder: {len(res.all_names())} variables, 501 points, t = 0..2 s)"
+    assert len(text) < 80
