@@ -95,23 +95,28 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         check_distinct_outputs(("-o", out), ("--plot", args.plot))
     if args.plot_vars:
         check_plot_vars(args.plot_vars, compiled)
+    from .validate import expand_outputs
+
+    outputs = expand_outputs(args.outputs, compiled) if args.outputs else None
+    if outputs is not None and args.plot_vars:
+        outputs += [n for n in args.plot_vars if n not in outputs]
     show = args.progress if args.progress is not None else (_TERMINAL or sys.stderr).isatty()
     try:
         result = simulate(compiled, stop_time=args.stop_time, interval=args.interval,
                           params=params, rtol=args.rtol, atol=args.atol,
                           solver=args.solver, max_step=args.max_step,
                           progress=_progress if show else None, inputs=args.input,
-                          init=args.init)
+                          init=args.init, outputs=outputs)
     except SimulationError as err:          # keep what was computed, and say so
         part = err.result
         if part is None or not len(part.time):
             raise SimulationError(f"{err} (nothing written to {out})", err.time_reached,
                                   part) from None
-        part.to_csv(out)
+        part.to_csv(out, outputs)
         raise SimulationError(f"{err} -- {len(part.time)} rows up to t = "
                               f"{float(part.time[-1]):g} s written to {out}",
                               err.time_reached, part) from None
-    result.to_csv(out)
+    result.to_csv(out, outputs)
     print(f"{compiled.name}: {len(result.time)} points, compile {compiled.compile_time:.3f} s, "
           f"run {result.meta['run_seconds']:.3f} s -> {out}")
     for note in result.meta.get("init_notes", []):
@@ -296,6 +301,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="time-varying values of the model's inputs: first column 'time', "
                           "one column per input (linear; a repeated time is a jump)")
     sim.add_argument("-o", "--output", help="CSV file (default <Model>.csv)")
+    sim.add_argument("--outputs", action="append", default=[], metavar="PATTERN[,PATTERN]",
+                     help="variables to write: names or globs (C*.v; * stays within a dotted "
+                          "part, ** crosses dots: 'motor.**'); default all")
     sim.add_argument("--plot", help="PNG file with the states (or --plot-vars)")
     sim.add_argument("--plot-vars", nargs="+", help="variables to plot")
     sim.add_argument("--rtol", type=float, default=None,
@@ -438,6 +446,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     parser = build_parser()
     _autocomplete(parser)
+    if not (sys.argv[1:] if argv is None else list(argv)):     # alone: the commands
+        parser.print_help()
+        return 0
     try:
         argv = _modelica_path_options(list(sys.argv[1:] if argv is None else argv))
     except ModelError as err:

@@ -151,17 +151,30 @@ def write_csv(result: Result, path: str | Path, names: Sequence[str] | None = No
     """``time,<names>`` per row; with ``units`` a second header row holds the units
     (``s,V,A,...``; an empty cell for a dimensionless or undeclared one)."""
     cols = _names(result, names)
-    table = np.column_stack([np.asarray(result.time, dtype=float)]
-                            + [np.asarray(result[n], dtype=float) for n in cols])
+    table = _table(result, cols)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    row = ",".join([fmt] * table.shape[1])
     with path.open("w", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(["time", *cols])
         if units:
             writer.writerow([UNITS_ROW, *[unit_of(result, n) for n in cols]])
-        writer.writerows(np.char.mod(fmt, table).tolist())
+        for start in range(0, len(table), 256):          # in bulk: one format per row
+            fh.write("\r\n".join(row % tuple(r) for r in table[start:start + 256].tolist()))
+            fh.write("\r\n")
     return path
+
+
+def _table(result: Result, cols: list[str]) -> np.ndarray:
+    """``time`` then the columns ``cols`` (aliases and parameters resolved), one array."""
+    index, values = result._index, result.values
+    direct = [index.get(n) for n in cols]
+    if all(k is not None for k in direct):                   # no alias: one gather
+        return np.column_stack([np.asarray(result.time, dtype=float),
+                                np.asarray(values, dtype=float)[:, direct]])
+    return np.column_stack([np.asarray(result.time, dtype=float)]
+                           + [np.asarray(result[n], dtype=float) for n in cols])
 
 
 def _is_number(text: str) -> bool:

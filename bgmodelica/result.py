@@ -30,6 +30,14 @@ class Result:
     def __post_init__(self) -> None:
         self._index = {n: k for k, n in enumerate(self.names)}
 
+    def __repr__(self) -> str:
+        """One line: ``Result(RobotPID: 162 variables, 501 points, t = 0..10 s)``."""
+        model = self.meta.get("model") or self.meta.get("name")
+        n = len(self.time)
+        span = f", t = {float(self.time[0]):g}..{float(self.time[-1]):g} s" if n else ""
+        return (f"Result({f'{model}: ' if model else ''}{len(self.names) + len(self.aliases)} "
+                f"variables, {n} points{span})")
+
     @property
     def values(self) -> np.ndarray:
         """All recorded variables, shape (N, len(names)); evaluated on first use."""

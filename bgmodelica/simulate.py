@@ -170,7 +170,8 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
     flat = compiled.declarations
     units = _units_by_name(dae, flat)
     params_out = dae.parameter_values(p)
-    meta = {"compile_seconds": compiled.compile_time, "run_seconds": run,
+    meta = {"model": compiled.name, "compile_seconds": compiled.compile_time,
+            "run_seconds": run,
             "timings": dict(compiled.timings), "solver": solver, "solver_choice": choice,
             **solver_meta, "stats": stats,
             "states": list(dae.state_names), "init_notes": init.notes}

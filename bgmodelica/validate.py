@@ -511,3 +511,42 @@ def check_sx_binding(name: str, value: Any) -> None:
         if sym is not None:
             check_binding(name, value, [sym], {id(sym): sym.name})
 
+
+
+def _glob(pattern: str) -> Any:
+    """A dotted-name glob as a regular expression: ``*`` and ``?`` stay inside one part of
+    the name (``C*.v`` is ``C1.v``, not ``C1.n.v``), ``**`` crosses dots."""
+    import re
+
+    parts = re.split(r"(\*\*|\*|\?)", pattern)
+    table = {"**": ".*", "*": "[^.]*", "?": "[^.]"}
+    return re.compile("".join(table.get(x, re.escape(x)) for x in parts))
+
+
+def expand_outputs(patterns: Sequence[str], compiled: Any) -> list[str]:
+    """The variable names matching ``patterns`` (names or globs, comma-separated items
+    allowed; see :func:`_glob`), in model order; :class:`OptionError` naming a pattern that
+    matches nothing."""
+    import difflib
+
+    names = list(compiled.dae.names) + sorted(getattr(compiled.dae, "aliases", {}) or {})
+    out: list[str] = []
+    seen: set[str] = set()
+    for item in patterns:
+        for pat in (p.strip() for p in item.split(",")):
+            if not pat:
+                continue
+            if any(c in pat for c in "*?"):
+                match = _glob(pat).fullmatch
+                hits = [n for n in names if match(n)]
+            else:
+                hits = [pat] if pat in names else []
+            if not hits:
+                close = difflib.get_close_matches(pat, names, n=3)
+                raise OptionError(f"--outputs {pat!r}: no such variable"
+                                  + (f"; did you mean {', '.join(close)}?" if close else ""))
+            for n in hits:
+                if n not in seen:
+                    seen.add(n)
+                    out.append(n)
+    return out

@@ -43,7 +43,7 @@ def simulate_hybrid(compiled, dae: CasadiDAE, p: np.ndarray, grid: np.ndarray, *
     units.update({d.name: d.decl.unit for d in flat.discretes})
     units.update({q.name: q.decl.unit for q in (*flat.parameters, *flat.inputs)})
     params_out = dae.parameter_values(p)
-    meta = {"compile_seconds": compiled.compile_time,
+    meta = {"model": compiled.name, "compile_seconds": compiled.compile_time,
             "run_seconds": _time.perf_counter() - t_start,
             "timings": dict(compiled.timings), "solver": "cvodes" if not dae.z.numel()
             else "idas", "solver_choice": "auto",      # the event loop picks by structure
