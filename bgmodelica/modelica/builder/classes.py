@@ -111,8 +111,57 @@ def class_view(scope: S.ClassScope, _stack: tuple = ()) -> ClassView:
         view.initial.extend((s, scope) for s in cdef.initial_algorithms)
     for u in refused(cdef):
         view.unsupported.append((u, scope))
+    _discrete_by_when(view)
     scope._view = view
     return view
+
+
+def _discrete_by_when(view: ClassView) -> None:
+    """A Real variable assigned in a when-equation or when-statement is discrete
+    (specification 3.8.3): mark its declaration so."""
+    import dataclasses
+
+    names: set[str] = set()
+
+    def lhs(eq: Any) -> None:
+        if isinstance(eq, A.EqSimple) and isinstance(eq.lhs, A.Ref):
+            names.add(eq.lhs.parts[0][0])
+        elif isinstance(eq, A.EqSimple) and isinstance(eq.lhs, A.TupleExpr):
+            names.update(i.parts[0][0] for i in eq.lhs.items if isinstance(i, A.Ref))
+        elif isinstance(eq, A.Assign) and isinstance(eq.target, A.Ref):
+            names.add(eq.target.parts[0][0])
+        elif isinstance(eq, (A.EqIf, A.StmtIf, A.EqWhen, A.StmtWhen)):
+            for _, body in eq.branches:
+                for sub in body:
+                    lhs(sub)
+            for sub in getattr(eq, "otherwise", ()):
+                lhs(sub)
+        elif isinstance(eq, (A.EqFor, A.StmtFor)):
+            for sub in eq.body:
+                lhs(sub)
+
+    def walk(items: Any) -> None:
+        for eq in items:
+            if isinstance(eq, (A.EqWhen, A.StmtWhen)):
+                lhs(eq)
+            elif isinstance(eq, (A.EqIf, A.StmtIf)):
+                for _, body in eq.branches:
+                    walk(body)
+                walk(getattr(eq, "otherwise", ()))
+            elif isinstance(eq, (A.EqFor, A.StmtFor, A.StmtWhile)):
+                walk(eq.body)
+            elif isinstance(eq, A.Statements):
+                walk(eq)
+
+    walk(eq for eq, _ in view.equations)
+    for name in names:
+        info = view.elements.get(name)
+        if info is None:
+            continue
+        pre = info.comp.prefixes
+        if pre & {"parameter", "constant", "discrete", "input", "output", "flow"}:
+            continue
+        info.comp = dataclasses.replace(info.comp, prefixes=pre | {"discrete"})
 
 
 def refused(cdef: A.ClassDef) -> list[A.Unsupported]:

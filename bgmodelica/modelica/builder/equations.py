@@ -63,6 +63,8 @@ def _eval_equation(eq: Any, ctx: Ctx, out: list, initial: bool) -> None:
                 b = evaluate(eq.rhs, ctx)
             except NotConstant as err:
                 raise fail(ctx.lex, eq, f"cannot evaluate: {err.what}") from None
+            if initial and _discrete_start(a, b, ctx, eq):
+                return
             _equation(a, b, ctx, eq, out)
         elif isinstance(eq, A.EqCall):
             _eval_call_equation(eq, ctx, out, initial)
@@ -90,6 +92,31 @@ def _eval_equation(eq: Any, ctx: Ctx, out: list, initial: bool) -> None:
         if isinstance(err, ModelicaError):
             raise
         raise fail(ctx.lex, eq, str(err)) from None
+
+
+def _discrete_start(a: Any, b: Any, ctx: Ctx, node: Any) -> bool:
+    """An initial equation ``d = value`` of a discrete variable whose value is known when
+    the model is built sets its start value (its value before the first event)."""
+    from ...core.variables import KIND_DISCRETE
+
+    if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+        if all(_discrete_start(x, y, ctx, node) for x, y in zip(a, b, strict=True)):
+            return True
+        return False
+    sym = getattr(a, "sym", None) if isinstance(a, Expr) else None
+    decl = getattr(sym, "decl", None)
+    if decl is None or decl.kind != KIND_DISCRETE:
+        return False
+    try:
+        value = numeric_value(b, ctx.lex, node)
+    except NotConstant:
+        return False
+    if isinstance(value, S.EnumValue):
+        value = value.index
+    if not isinstance(value, (bool, int, float)):
+        return False
+    sym.decl = decl.evolve(start=value, fixed=True)
+    return True
 
 
 def _tuple_equation(eq: A.EqSimple, ctx: Ctx, out: list) -> None:
