@@ -19,8 +19,6 @@ CASES = [
     ("model M\n  Real x;\nequation\n  der(x) = -x\nend M;\n", 5, 1, "unexpected 'end'"),
     ("model M\n  Real x;\n", 2, 10, "unexpected end of file"),
     ("model M\n  Real x # 2;\nend M;\n", 2, 10, "unexpected character '#'"),
-    ("model M\n  Real x;\nalgorithm\n  x := 1;\nend M;\n", 3, 1,
-     "unsupported Modelica construct: algorithm section"),
     ("model M\n  inner Real x;\nequation\n  x = 1;\nend M;\n", 2, 14,
      "unsupported Modelica construct: inner"),
     ("model M\n  Real x;\nequation\n  der(x) = -y;\nend M;\n", 4, 13, "unknown name 'y'"),

@@ -205,6 +205,17 @@ class _State:
         self.leaves: dict = {}                # the model variables a model's algorithm assigns
 
 
+def _known(v: Any, ctx: Ctx) -> Any:
+    """``v`` as a number when it depends on parameters only (they are known when the model
+    is built), else ``v``."""
+    if not _symbolic(v):
+        return v
+    try:
+        return numeric_value(v, ctx.lex)
+    except NotConstant:
+        return v
+
+
 def _symbolic(v: Any) -> bool:
     if isinstance(v, list):
         return any(_symbolic(x) for x in v)
@@ -228,7 +239,7 @@ def _run(stmts: tuple, ctx: Ctx, state: _State) -> None:
             _for(st, ctx, state)
         elif t is A.StmtWhile:
             while True:
-                c = evaluate(st.condition, ctx)
+                c = _known(evaluate(st.condition, ctx), ctx)
                 if _symbolic(c):
                     raise fail(ctx.lex, st, "while-loop condition depends on time-varying "
                                "values (not supported)")
@@ -260,7 +271,7 @@ def _if(st: A.StmtIf, ctx: Ctx, state: _State) -> None:
     from .evaluate import evaluate
 
     for k, (cond, body) in enumerate(st.branches):
-        c = evaluate(cond, ctx)
+        c = _known(evaluate(cond, ctx), ctx)
         if not _symbolic(c):
             if c:
                 _run(body, ctx, state)
@@ -385,7 +396,7 @@ def _store(ref: Any, value: Any, ctx: Ctx, node: Any) -> None:
         if isinstance(s, A.Colon):
             idx.append(None)
             continue
-        v = evaluate(s, num)
+        v = _known(evaluate(s, num), ctx)
         if _symbolic(v):
             raise fail(ctx.lex, node, f"subscript of {name} depends on time-varying values")
         idx.append(v)

@@ -84,13 +84,28 @@ _NUM_OPS = {
 }
 
 
-def numeric_value(v: Any, lex: Any = None, node: Any = None) -> Any:
+def numeric_value(v: Any, lex: Any = None, node: Any = None, _memo: dict | None = None) -> Any:
     """``v`` with parameters replaced by their values (raises :class:`NotConstant` if it
-    depends on variables or time)."""
+    depends on variables or time). Shared subexpressions are evaluated once."""
     if isinstance(v, (bool, int, float, str, S.EnumValue)):
         return v
     if isinstance(v, list):
-        return [numeric_value(x, lex, node) for x in v]
+        if _memo is None:
+            _memo = {}
+        return [numeric_value(x, lex, node, _memo) for x in v]
+    if isinstance(v, Op):
+        if _memo is None:
+            _memo = {}
+        hit = _memo.get(id(v))
+        if hit is not None:
+            return hit[1]
+        args = [numeric_value(a, lex, node, _memo) for a in v.args]
+        fn = _NUM_OPS.get(v.op)
+        if fn is None:
+            raise NotConstant(f"operation {v.op}")
+        out = fn(*args)
+        _memo[id(v)] = (v, out)
+        return out
     if isinstance(v, Leaf):
         sym = v.sym
         if sym is TIME:

@@ -116,6 +116,16 @@ def class_view(scope: S.ClassScope, _stack: tuple = ()) -> ClassView:
     return view
 
 
+def constraining_mod(info: ElemInfo) -> Any:
+    """The modifiers a redeclaration of ``info`` keeps: those of a ``replaceable``
+    declaration without ``constrainedby`` (its type and modifiers constrain the new one,
+    specification 7.3.2); none for other declarations."""
+    comp = info.comp
+    if "replaceable" in comp.element_prefixes and comp.constrainedby is None:
+        return info.mod
+    return None
+
+
 def _discrete_by_when(view: ClassView) -> None:
     """A Real variable assigned in a when-equation or when-statement is discrete
     (specification 3.8.3): mark its declaration so."""
@@ -194,9 +204,9 @@ def _inherit(view: ClassView, base: ClassView, ext_mod: Mod | None) -> None:
         new = ElemInfo(info.comp, info.lex, merge(outer, info.mod))
         if outer is not None and outer.redeclare is not None:
             el, lex = outer.redeclare
-            # the replaced declaration's modifiers still apply (under the new ones)
             new = ElemInfo(el, lex, merge(_without_redeclare(outer),
-                                          merge(mod_from_ast(el.mod, SELF, lex), info.mod)))
+                                          merge(mod_from_ast(el.mod, SELF, lex),
+                                                constraining_mod(info))))
         view.elements[name] = new
     if ext_mod is not None:
         for name, m in ext_mod.sub.items():

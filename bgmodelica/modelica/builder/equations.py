@@ -56,14 +56,14 @@ def _eval_equation(eq: Any, ctx: Ctx, out: list, initial: bool) -> None:
 
             section_equations(eq, ctx, out, initial)
         elif isinstance(eq, A.EqSimple) and isinstance(eq.lhs, A.TupleExpr):
-            _tuple_equation(eq, ctx, out)
+            _tuple_equation(eq, ctx, out, initial)
         elif isinstance(eq, A.EqSimple):
             try:
                 a = evaluate(eq.lhs, ctx)
                 b = evaluate(eq.rhs, ctx)
             except NotConstant as err:
                 raise fail(ctx.lex, eq, f"cannot evaluate: {err.what}") from None
-            if initial and _discrete_start(a, b, ctx, eq):
+            if initial and (_discrete_start(a, b, ctx, eq) or _parameter_value(a, b, ctx, eq)):
                 return
             _equation(a, b, ctx, eq, out)
         elif isinstance(eq, A.EqCall):
@@ -119,7 +119,73 @@ def _discrete_start(a: Any, b: Any, ctx: Ctx, node: Any) -> bool:
     return True
 
 
-def _tuple_equation(eq: A.EqSimple, ctx: Ctx, out: list) -> None:
+def _parameter_value(a: Any, b: Any, ctx: Ctx, node: Any) -> bool:
+    """An initial equation ``p = value`` of a parameter declared ``fixed = false`` whose value
+    is known when the model is built (from other parameters): the parameter takes it."""
+    from ...core.variables import KIND_PARAMETER
+
+    pairs = list(zip(a, b, strict=True)) if isinstance(a, list) and isinstance(b, list) \
+        and len(a) == len(b) else [(a, b)]
+    found = []
+    for x, y in pairs:
+        if isinstance(x, list) or isinstance(y, list):
+            if not (isinstance(x, list) and isinstance(y, list) and len(x) == len(y)):
+                return False
+            found.extend(zip(x, y, strict=True))
+        else:
+            found.append((x, y))
+    solved = []
+    for x, y in found:
+        sym = getattr(x, "sym", None) if isinstance(x, Expr) else None
+        decl = getattr(sym, "decl", None)
+        if decl is None or decl.kind != KIND_PARAMETER:
+            return False
+        try:
+            value = numeric_value(y, ctx.lex, node)
+        except NotConstant:
+            return False
+        if isinstance(value, S.EnumValue):
+            value = value.index
+        if not isinstance(value, (bool, int, float)):
+            return False
+        solved.append((sym, decl, float(value)))
+    for sym, decl, value in solved:
+        sym.decl = decl.evolve(value=value)
+        _remember(sym, value)
+    return bool(solved)
+
+
+def _remember(sym: Any, value: float) -> None:
+    """Let later build-time evaluations of the owner see a solved parameter's value."""
+    import re
+
+    owner = getattr(sym, "owner", None)
+    env = owner.__dict__.get("_mo_env") if owner is not None else None
+    if env is None:
+        return
+    m = re.match(r"^(.*)\[([0-9,]+)\]$", sym.name)
+    if m is None:
+        env._num[sym.name] = value
+        return
+    try:
+        whole = env.numeric(m.group(1))
+    except (KeyError, NotConstant):
+        return
+    if not isinstance(whole, list):
+        return
+    whole = env._num[m.group(1)] = _deep_copy(whole)
+    idx = [int(i) - 1 for i in m.group(2).split(",")]
+    cur = whole
+    for i in idx[:-1]:
+        cur = cur[i]
+    cur[idx[-1]] = value
+
+
+def _deep_copy(v: Any) -> Any:
+    return [_deep_copy(x) for x in v] if isinstance(v, list) else v
+
+
+def _tuple_equation(eq: A.EqSimple, ctx: Ctx, out: list, initial: bool) -> None:
     """``(a, , b) = f(x)``: one equation per named output."""
     from .algorithms import call_outputs
 
@@ -129,7 +195,11 @@ def _tuple_equation(eq: A.EqSimple, ctx: Ctx, out: list) -> None:
         values = call_outputs(eq.rhs, ctx)
         for item, v in zip(eq.lhs.items, values, strict=False):
             if item is not None:
-                _equation(evaluate(item, ctx), v, ctx, eq, out)
+                a = evaluate(item, ctx)
+                if initial and (_discrete_start(a, v, ctx, eq)
+                                or _parameter_value(a, v, ctx, eq)):
+                    continue
+                _equation(a, v, ctx, eq, out)
     except NotConstant as err:
         raise fail(ctx.lex, eq, f"cannot evaluate: {err.what}") from None
 

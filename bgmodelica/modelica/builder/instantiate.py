@@ -16,7 +16,15 @@ from .. import scope as S
 from ..errors import ModelicaError
 from .arith import _neg
 from .base import _RESERVED, SELF, Ctx, NotConstant, fail, numeric_value
-from .classes import ClassView, ElemInfo, TypeRef, class_view, resolve_class, type_ref
+from .classes import (
+    ClassView,
+    ElemInfo,
+    TypeRef,
+    class_view,
+    constraining_mod,
+    resolve_class,
+    type_ref,
+)
 from .declarations import _elem_name, _indices, _instance_decl, _override, _static_decl, apply_mods
 from .env import Env, _category, _dims
 from .equations import _declaration_equations, equations_of
@@ -150,7 +158,8 @@ def _plan(view: ClassView, env: Env, connector: bool) -> tuple:
         if m is not None and m.redeclare is not None:
             el, lex = m.redeclare
             info = ElemInfo(el, lex, merge(_without_redeclare(m),
-                                           merge(mod_from_ast(el.mod, SELF, lex), info.mod)))
+                                           merge(mod_from_ast(el.mod, SELF, lex),
+                                                 constraining_mod(info))))
             cacheable = False
             env.view = view = _with_element(view, name, info, env)
             env.mods = {k: v for k, v in env.mods.items() if k != name}
