@@ -57,6 +57,13 @@ class CompiledModel:
     def compile_time(self) -> float:
         return sum(self.timings.values())
 
+    def __repr__(self) -> str:
+        """One line: name, counts and compile time (the whole structure is in
+        :meth:`summary` and, in a notebook, the rich view)."""
+        return (f"CompiledModel({self.name}: {len(self.reduced.states)} states, "
+                f"{len(self.sorted.algebraic)} algebraic, {len(self.dae.parameters)} "
+                f"parameters, compiled in {self.compile_time:.2g} s)")
+
     def _repr_html_(self) -> str:
         """Jupyter view: structure and parameters (:func:`bgmodelica.notebook.compiled_html`)."""
         from .notebook import compiled_html
