@@ -157,7 +157,7 @@ class CompiledModel:
         }
 
 
-def compile(model: Component, *, select: Selector | None = None,  # noqa: A001
+def compile(model: Component | str, *, select: Selector | None = None,  # noqa: A001
             units: str = "error", cache: bool | str | Path = False,
             array_path: bool = True) -> CompiledModel:
     """Compile a component tree into a :class:`CompiledModel`.
@@ -179,7 +179,15 @@ def compile(model: Component, *, select: Selector | None = None,  # noqa: A001
     when first read. ``array_path=False`` sends every model through the scalar pipeline.
 
     The cyclic garbage collector is paused meanwhile: compilation allocates millions of
-    objects that live until the end, and rescanning them costs more than it frees."""
+    objects that live until the end, and rescanning them costs more than it frees.
+
+    ``model`` may also be a MODEL reference as on the command line (``"library.examples:RC"``,
+    ``"path/file.py:Name"``, ``"file.mo:Package.Model"``; see
+    :func:`~bgmodelica.load_model`)."""
+    if isinstance(model, str):
+        from .loader import load_model
+
+        model = load_model(model)
     if select is None and array_path:
         from .array_path import compile_arrays
 
