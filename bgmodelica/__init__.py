@@ -3,7 +3,7 @@
 Public API::
 
     from bgmodelica import Component, Connector, Parameter, Variable, Potential, Flow, \
-        Input, Output, StateSelect, connect, der, time, compile, simulate
+        Input, Output, StateSelect, connect, der, time, compile, simulate, load_model, export_fmu
 """
 
 from .core.arrays import ArrayExpr, array_of
@@ -89,3 +89,8 @@ __all__ += ["sweep", "fit"]
 from .modelica import export_modelica, load_modelica  # noqa: E402  (lark loads on first use)
 
 __all__ += ["load_modelica", "export_modelica"]
+
+from .fmu_export import export_fmu  # noqa: E402
+from .loader import load_model  # noqa: E402
+
+__all__ += ["export_fmu", "load_model"]

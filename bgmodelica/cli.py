@@ -56,6 +56,7 @@ def _progress(frac: float) -> None:
 def _check_simulate_args(args: argparse.Namespace) -> None:
     """Options and output files, before any model is loaded (nothing is written)."""
     from .errors import OptionError
+    from .result_files import format_of
     from .validate import (
         check_distinct_outputs,
         check_output_file,
@@ -69,6 +70,7 @@ def _check_simulate_args(args: argparse.Namespace) -> None:
         raise OptionError("--plot-vars needs --plot FILE to draw them in")
     if args.output:
         check_output_file(args.output, "-o")
+        format_of(args.output)               # a known format whose package is installed
     if args.plot:
         check_plot_file(args.plot, "--plot")
     check_distinct_outputs(("-o", args.output), ("--plot", args.plot))
@@ -81,6 +83,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     from .errors import SimulationError
     from .loader import load_model
     from .modelica.cli import apply_experiment_defaults
+    from .result_files import save, write_progress
     from .simulate import simulate
     from .validate import check_distinct_outputs, check_output_file, check_plot_vars
 
@@ -101,6 +104,10 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     if outputs is not None and args.plot_vars:
         outputs += [n for n in args.plot_vars if n not in outputs]
     show = args.progress if args.progress is not None else (_TERMINAL or sys.stderr).isatty()
+
+    def writing():                          # a bar for a long write (from when it starts)
+        return write_progress(show, _TERMINAL or sys.stderr, 0.0 if args.progress else 0.5)
+
     try:
         result = simulate(compiled, stop_time=args.stop_time, interval=args.interval,
                           params=params, rtol=args.rtol, atol=args.atol,
@@ -112,11 +119,11 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         if part is None or not len(part.time):
             raise SimulationError(f"{err} (nothing written to {out})", err.time_reached,
                                   part) from None
-        part.to_csv(out, outputs)
+        save(part, out, outputs, progress=writing())
         raise SimulationError(f"{err} -- {len(part.time)} rows up to t = "
                               f"{float(part.time[-1]):g} s written to {out}",
                               err.time_reached, part) from None
-    result.to_csv(out, outputs)
+    save(result, out, outputs, progress=writing())
     print(f"{compiled.name}: {len(result.time)} points, compile {compiled.compile_time:.3f} s, "
           f"run {result.meta['run_seconds']:.3f} s -> {out}")
     for note in result.meta.get("init_notes", []):
@@ -300,7 +307,8 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--input", metavar="FILE.csv",
                      help="time-varying values of the model's inputs: first column 'time', "
                           "one column per input (linear; a repeated time is a jump)")
-    sim.add_argument("-o", "--output", help="CSV file (default <Model>.csv)")
+    sim.add_argument("-o", "--output", help="result file by extension: .csv, .parquet or .nc "
+                     "(default <Model>.csv)")
     sim.add_argument("--outputs", action="append", default=[], metavar="PATTERN[,PATTERN]",
                      help="variables to write: names or globs (C*.v; * stays within a dotted "
                           "part, ** crosses dots: 'motor.**'); default all")
@@ -316,7 +324,8 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--max-step", type=float, default=None, metavar="SECONDS",
                      help="largest internal step of the integrator [s]")
     sim.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
-                     help="progress bar (default: when stderr is a terminal)")
+                     help="progress bars of the run and of long writes (default: when stderr "
+                     "is a terminal)")
     sim.set_defaults(func=cmd_simulate)
 
     chk = sub.add_parser("check", help="balance, structural index, states, loops")

@@ -57,6 +57,13 @@ class CompiledModel:
     def compile_time(self) -> float:
         return sum(self.timings.values())
 
+    def __repr__(self) -> str:
+        """One line: name, counts and compile time (the whole structure is in
+        :meth:`summary` and, in a notebook, the rich view)."""
+        return (f"CompiledModel({self.name}: {len(self.reduced.states)} states, "
+                f"{len(self.sorted.algebraic)} algebraic, {len(self.dae.parameters)} "
+                f"parameters, compiled in {self.compile_time:.2g} s)")
+
     def _repr_html_(self) -> str:
         """Jupyter view: structure and parameters (:func:`bgmodelica.notebook.compiled_html`)."""
         from .notebook import compiled_html
@@ -150,7 +157,7 @@ class CompiledModel:
         }
 
 
-def compile(model: Component, *, select: Selector | None = None,  # noqa: A001
+def compile(model: Component | str, *, select: Selector | None = None,  # noqa: A001
             units: str = "error", cache: bool | str | Path = False,
             array_path: bool = True) -> CompiledModel:
     """Compile a component tree into a :class:`CompiledModel`.
@@ -172,7 +179,15 @@ def compile(model: Component, *, select: Selector | None = None,  # noqa: A001
     when first read. ``array_path=False`` sends every model through the scalar pipeline.
 
     The cyclic garbage collector is paused meanwhile: compilation allocates millions of
-    objects that live until the end, and rescanning them costs more than it frees."""
+    objects that live until the end, and rescanning them costs more than it frees.
+
+    ``model`` may also be a MODEL reference as on the command line (``"library.examples:RC"``,
+    ``"path/file.py:Name"``, ``"file.mo:Package.Model"``; see
+    :func:`~bgmodelica.load_model`)."""
+    if isinstance(model, str):
+        from .loader import load_model
+
+        model = load_model(model)
     if select is None and array_path:
         from .array_path import compile_arrays
 

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import csv
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -85,16 +85,15 @@ def to_xarray(result: Result, names: Sequence[str] | None = None,
     import xarray as xr
 
     cols = _names(result, names)
-    time = xr.DataArray(np.asarray(result.time, dtype=float), dims="time",
-                        attrs={"units": "s", "long_name": "time"})
-    data = {n: xr.DataArray(np.asarray(result[n], dtype=float), dims="time",
-                            attrs={"units": unit_of(result, n), "long_name": n})
-            for n in cols}
+    table = _table(result, cols)        # one gather; xr.Variable costs less than DataArray
+    time = xr.Variable("time", table[:, 0], {"units": "s", "long_name": "time"})
+    data = {n: xr.Variable("time", table[:, k], {"units": unit_of(result, n), "long_name": n})
+            for k, n in enumerate(cols, start=1)}
     if parameters:
         for n, v in result.parameters.items():
             if n not in data:
-                data[n] = xr.DataArray(float(v), attrs={"units": result.units.get(n, ""),
-                                                        "long_name": n, "kind": "parameter"})
+                data[n] = xr.Variable((), float(v), {"units": result.units.get(n, ""),
+                                                     "long_name": n, "kind": "parameter"})
     attrs = _meta_attrs(result)
     return xr.Dataset(data, coords={"time": time}, attrs=attrs)
 
@@ -136,7 +135,8 @@ def from_xarray(ds: Any) -> Result:
     cols: dict[str, np.ndarray] = {}
     params: dict[str, float] = {}
     units: dict[str, str] = {}
-    for name, var in ds.data_vars.items():
+    for name in ds.data_vars:          # ds.variables: no DataArray made per variable
+        var = ds.variables[name]
         units[str(name)] = str(var.attrs.get("units", ""))
         if var.ndim == 0:
             params[str(name)] = float(var.values)
@@ -147,9 +147,11 @@ def from_xarray(ds: Any) -> Result:
 
 
 def write_csv(result: Result, path: str | Path, names: Sequence[str] | None = None,
-              units: bool = False, fmt: str = "%.12g") -> Path:
+              units: bool = False, fmt: str = "%.12g",
+              progress: Callable[[float], None] | None = None) -> Path:
     """``time,<names>`` per row; with ``units`` a second header row holds the units
-    (``s,V,A,...``; an empty cell for a dimensionless or undeclared one)."""
+    (``s,V,A,...``; an empty cell for a dimensionless or undeclared one). ``progress`` is
+    called with the fraction written after each block of rows."""
     cols = _names(result, names)
     table = _table(result, cols)
     path = Path(path)
@@ -163,6 +165,8 @@ def write_csv(result: Result, path: str | Path, names: Sequence[str] | None = No
         for start in range(0, len(table), 256):          # in bulk: one format per row
             fh.write("\r\n".join(row % tuple(r) for r in table[start:start + 256].tolist()))
             fh.write("\r\n")
+            if progress is not None:
+                progress(min(1.0, (start + 256) / len(table)))
     return path
 
 

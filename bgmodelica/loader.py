@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import difflib
 import importlib
 import importlib.util
 import inspect
@@ -9,7 +10,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from .core.component import Component
+from .core.component import Component, Connector
 from .errors import ModelError, ModelLoadError, OptionError, UserCodeError
 from .validate import check_model_args, user_error, user_location
 
@@ -30,11 +31,7 @@ def load_model(ref: str, **kwargs: Any) -> Component:
                              "'package.module:Name' or 'file.mo:Package.Model'")
     module = _load_module(target)
     if not hasattr(module, name):
-        public = [n for n, v in vars(module).items() if not n.startswith("_") and (
-            inspect.isclass(v) and issubclass(v, Component) and v.__module__ == module.__name__
-            or inspect.isfunction(v) and v.__module__ == module.__name__)]
-        raise ModelLoadError(f"{target} has no model named {name!r}; it defines: "
-                             f"{', '.join(sorted(public)) or 'no models'}")
+        raise ModelLoadError(_missing(target, name, module_models(module)))
     obj = getattr(module, name)
     if isinstance(obj, Component):
         if kwargs:
@@ -160,3 +157,46 @@ def _import_failure(target: str, err: BaseException) -> ModelLoadError:
     text = str(err).strip().splitlines()[0] if str(err).strip() else ""
     return ModelLoadError(f"cannot import {target}: {type(err).__name__}"
                           + (f": {text}" if text else "") + (f" at {loc}" if loc else ""))
+
+
+def module_models(module) -> list[str]:
+    """Names of the models ``module`` offers, sorted: Component classes (not connectors) and
+    public functions defined in it, re-exported from its own submodules, or listed in its
+    ``__all__``."""
+    own = module.__name__
+    listed = set(getattr(module, "__all__", ()) or ())
+    package = own + "." if hasattr(module, "__path__") else None
+
+    def offered(value) -> bool:
+        where = getattr(value, "__module__", "") or ""
+        return (where == own or bool(package) and where.startswith(package))
+
+    names = []
+    for key, value in vars(module).items():
+        if key.startswith("_"):
+            continue
+        if inspect.isclass(value):
+            if not issubclass(value, Component) or issubclass(value, Connector):
+                continue
+            if value is Component or value.__module__.startswith("bgmodelica.core"):
+                continue
+        elif not inspect.isfunction(value):
+            continue
+        if key in listed or offered(value):
+            names.append(key)
+    return sorted(names)
+
+
+def _missing(target: str, name: str, models: list[str]) -> str:
+    """One line: ``target`` has no model ``name``; the close spellings, then what it offers."""
+    text = f"{target} has no model named {name!r}"
+    by_case = {m.lower(): m for m in models}
+    close = difflib.get_close_matches(name, models, n=3, cutoff=0.6)
+    if name.lower() in by_case and by_case[name.lower()] not in close:
+        close.insert(0, by_case[name.lower()])
+    if close:
+        text += f"; did you mean {', '.join(close)}?"
+    if not models:
+        return text + " (it offers no models: Component classes or functions)"
+    shown = ", ".join(models[:20]) + (f", ... ({len(models)} in all)" if len(models) > 20 else "")
+    return text + f" (it offers: {shown})"

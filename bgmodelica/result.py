@@ -92,6 +92,51 @@ class Result:
 
         return write_csv(self, path, names, units=units)
 
+    def save(self, path: str | Path, names: Sequence[str] | None = None, *,
+             units: bool = False, progress: Callable[[float], None] | None = None) -> Path:
+        """Write by extension: ``.parquet`` (pyarrow), ``.nc`` (netCDF), else CSV (``units``:
+        the units row); ``progress`` is called with the fraction written. :meth:`read` reads
+        any of them back (see :mod:`bgmodelica.result_files`)."""
+        from .result_files import save
+
+        return save(self, path, names, units=units, progress=progress)
+
+    @classmethod
+    def read(cls, path: str | Path) -> Result:
+        """A result from a ``.csv``, ``.parquet`` or ``.nc`` file written by :meth:`save`."""
+        from .result_files import read
+
+        return read(path)
+
+    def to_parquet(self, path: str | Path, names: Sequence[str] | None = None) -> Path:
+        """Write ``time`` and the variables (default: every one, aliases included) as an
+        Apache Parquet file, units in the field metadata, parameters in the schema metadata;
+        :meth:`read_parquet` reads it back."""
+        from .result_files import write_parquet
+
+        return write_parquet(self, path, names)
+
+    @classmethod
+    def read_parquet(cls, path: str | Path) -> Result:
+        """A result from a Parquet file written by :meth:`to_parquet`."""
+        from .result_files import read_parquet
+
+        return read_parquet(path)
+
+    def to_netcdf(self, path: str | Path, names: Sequence[str] | None = None) -> Path:
+        """Write the Dataset of :meth:`to_xarray` as netCDF (4 with h5netcdf, else 3);
+        :meth:`read_netcdf` reads it back."""
+        from .result_files import write_netcdf
+
+        return write_netcdf(self, path, names)
+
+    @classmethod
+    def read_netcdf(cls, path: str | Path) -> Result:
+        """A result from a netCDF file written by :meth:`to_netcdf`."""
+        from .result_files import read_netcdf
+
+        return read_netcdf(path)
+
     @classmethod
     def read_csv(cls, path: str | Path) -> Result:
         """A result from a CSV file written by :meth:`to_csv` (units row optional)."""

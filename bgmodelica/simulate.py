@@ -38,7 +38,7 @@ _HINTS = {
 }
 
 
-def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
+def simulate(model: Component | CompiledModel | str, stop_time: float = 1.0,
              interval: float | None = None, params: dict[str, Any] | None = None, *,
              start_time: float = 0.0, rtol: float = 1e-6, atol: float = 1e-8,
              max_step: float | None = None, max_steps: int = 100000, solver: str = "auto",
@@ -48,53 +48,59 @@ def simulate(model: Component | CompiledModel, stop_time: float = 1.0,
              sensitivities: Sequence[str] | None = None,
              sensitivity_method: str = "forward", init: str = "start",
              linear_solver: str = "auto", jit: bool | str = False) -> Result:
-    """Simulate ``model`` from ``start_time`` to ``stop_time`` [s].
+    """Simulate ``model`` from ``start_time`` to ``stop_time`` [s] and return a :class:`Result`.
 
-    init: ``"start"`` (default): the initial conditions are the fixed start values and the
-    components' initial equations; ``"steady-state"``: the steady state der(x) = 0 with the
-    given parameters and inputs, every start value a guess (see
-    :func:`bgmodelica.steady_state`).
+    Parameters:
 
-    interval: output grid step [s]: the result holds exactly ``start_time + k*interval``
-    below ``stop_time``, then ``stop_time`` (default: 500 equal intervals). Options that are
-    NaN, Inf, zero or negative, or a grid too large to hold, raise
-    :class:`~bgmodelica.errors.OptionError`; parameters and fixed start values outside their
-    declared ``min``/``max`` :class:`ParameterError`; a model undefined at its initial point
-    (division by zero, log of a negative number) :class:`InitializationError` naming the
-    equation; NaN/Inf in the result :class:`SimulationError` naming the variable and time,
-    with ``.result`` holding the rows before. params: overrides by dotted name
-    of parameters, model inputs (held constant) or start values of variables. rtol/atol:
-    integrator tolerances; max_step: largest internal step [s]. solver: "auto" (default:
-    CVODES when the reduced model is an explicit ODE, no algebraic unknowns left; IDAS
-    otherwise), "idas" or "cvodes" (ODE models only); ``result.meta["solver"]`` says which ran
-    and ``meta["solver_choice"]`` whether it was chosen automatically. outputs: names to
-    record (default: every variable).
-    dynamic: allow dynamic state selection when index reduction left a choice whose
-    conditioning depends on the state (see :mod:`bgmodelica.dynamic_selection`).
-    progress: called with the fraction done after each chunk of the run.
-    inputs: time-varying values of top-level ``Input``s: a CSV path or a mapping of input name
-    to ``(times, values)`` (see :mod:`bgmodelica.events.inputs`).
-    A value in ``params`` may carry a unit (``{"R.R": "2 kOhm"}``): it is converted to the
-    declared unit. units: the unit check of :func:`~bgmodelica.compile` when ``model`` is a
-    component ("error", "warn" or "off").
+    - ``model``: a :class:`~bgmodelica.Component`, a :class:`~bgmodelica.CompiledModel`
+      (compile once, simulate many times) or a MODEL reference as on the command line
+      (``"library.examples:RC"``, ``"path/file.py:Name"``, ``"file.mo:Package.Model"``).
+    - ``stop_time``, ``start_time`` [s]: the time span (default 0 to 1 s).
+    - ``interval`` [s]: output grid step: the result holds exactly ``start_time +
+      k*interval`` below ``stop_time``, then ``stop_time`` (default: 500 equal intervals).
+    - ``params``: overrides by dotted name of parameters, model inputs (held constant) or
+      start values of variables; a value may carry a unit (``{"R.R": "2 kOhm"}``), converted
+      to the declared unit.
+    - ``rtol``, ``atol``: integrator tolerances; ``max_step`` [s]: largest internal step;
+      ``max_steps``: most internal steps per output interval.
+    - ``solver``: ``"auto"`` (default: CVODES when the reduced model is an explicit ODE, no
+      algebraic unknowns left; IDAS otherwise), ``"idas"`` or ``"cvodes"`` (ODE models only);
+      ``result.meta["solver"]`` says which ran and ``meta["solver_choice"]`` whether it was
+      chosen automatically.
+    - ``outputs``: names to record (default: every variable).
+    - ``dynamic``: allow dynamic state selection when index reduction left a choice whose
+      conditioning depends on the state (see :mod:`bgmodelica.dynamic_selection`).
+    - ``progress``: called with the fraction done after each chunk of the run.
+    - ``inputs``: time-varying values of top-level ``Input``s: a CSV path or a mapping of input
+      name to ``(times, values)`` (see :mod:`bgmodelica.events.inputs`).
+    - ``units``: the unit check of :func:`~bgmodelica.compile` when ``model`` is compiled here
+      (``"error"``, ``"warn"`` or ``"off"``).
+    - ``sensitivities``: parameters / inputs p_j to differentiate the recorded variables with
+      respect to: ``result.sensitivity("rotor.w", "resistor.R")`` is d(rotor.w)/d(resistor.R)
+      along ``result.time``; ``sensitivity_method``: ``"forward"`` (CVODES/IDAS forward
+      sensitivities through CasADi; refused for models with events) or ``"fd"`` (central
+      finite differences of whole runs, labelled so in ``result.meta["sensitivity_method"]``);
+      see :mod:`bgmodelica.studies.sensitivity`.
+    - ``init``: ``"start"`` (default): the initial conditions are the fixed start values and
+      the components' initial equations; ``"steady-state"``: the steady state der(x) = 0 with
+      the given parameters and inputs, every start value a guess (see
+      :func:`bgmodelica.steady_state`).
+    - ``linear_solver``: the direct solver of the Newton iterations: ``"auto"`` (sparse QR,
+      measured best at every size), ``"qr"``, ``"csparse"`` (sparse LU), ``"lapacklu"`` or
+      ``"lapackqr"`` (dense); ``jit``: compile the model functions to C first (True, or an
+      optimization level ``"O1"``, ``"O2"``; worth it for long or repeated runs, see
+      :mod:`bgmodelica.solver_options`). ``result.meta`` reports ``linear_solver`` and ``jit``.
 
     Models with events (relations, ``when``, ``sample``, tables) or with ``inputs`` run in
     the event loop (:mod:`bgmodelica.events`): at every event the result holds two rows with
     the same time, the left and the right limit; ``result.meta["event_times"]`` lists them.
 
-    linear_solver: the direct solver of the Newton iterations: ``"auto"`` (sparse QR, measured
-    best at every size), ``"qr"``, ``"csparse"`` (sparse LU), ``"lapacklu"`` or
-    ``"lapackqr"`` (dense); jit: compile the model functions to C first (True, or an
-    optimization level "O1", "O2"; worth it for long or repeated runs, see
-    :mod:`bgmodelica.solver_options`). ``result.meta`` reports
-    ``linear_solver`` and ``jit``.
-
-    sensitivities: parameters / inputs p_j to differentiate the recorded variables with
-    respect to: ``result.sensitivity("rotor.w", "resistor.R")`` is d(rotor.w)/d(resistor.R)
-    along ``result.time``. sensitivity_method: ``"forward"`` (CVODES/IDAS forward
-    sensitivities through CasADi; refused for models with events) or ``"fd"`` (central finite
-    differences of whole runs, labelled so in ``result.meta["sensitivity_method"]``); see
-    :mod:`bgmodelica.studies.sensitivity`.
+    Errors: options that are NaN, Inf, zero or negative, or a grid too large to hold, raise
+    :class:`~bgmodelica.errors.OptionError`; parameters and fixed start values outside their
+    declared ``min``/``max`` :class:`ParameterError`; a model undefined at its initial point
+    (division by zero, log of a negative number) :class:`InitializationError` naming the
+    equation; NaN/Inf in the result :class:`SimulationError` naming the variable and time,
+    with ``.result`` holding the rows before.
     """
     opt = check_run_options(start_time=start_time, stop_time=stop_time, interval=interval,
                             rtol=rtol, atol=atol, max_step=max_step, max_steps=max_steps,

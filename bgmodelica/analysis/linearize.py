@@ -123,7 +123,8 @@ def linearize(model: Any, params: dict[str, Any] | None = None, *, steady_state:
               outputs: Sequence[str] | None = None, exclude: Sequence[str] = (),
               t: float = 0.0, tol: float = 1e-10, units: str = "error",
               point: OperatingPoint | None = None):
-    """Linearize ``model`` (a component or compiled model) and return a python-control
+    """Linearize ``model`` (a component, compiled model or MODEL reference such as
+    ``"library.examples:DCMotor"``) and return a python-control
     ``StateSpace`` with named states, inputs and outputs.
 
     The operating point: the consistent initial point from the start values (default; start

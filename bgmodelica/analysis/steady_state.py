@@ -138,7 +138,8 @@ def _cached(dae: CasadiDAE, key: str, make) -> Any:
 def steady_state(model: Any, params: dict[str, Any] | None = None, *, t: float = 0.0,
                  exclude: Sequence[str] = (), tol: float = 1e-10, max_iter: int = 100,
                  units: str = "error") -> OperatingPoint:
-    """The steady state of ``model`` (a component or a compiled model): ``der(x) = 0`` for
+    """The steady state of ``model`` (a component, a compiled model or a MODEL reference such
+    as ``"library.examples:RC"``): ``der(x) = 0`` for
     every state (but those in ``exclude``) with the parameters and inputs in ``params``; the
     start values (the model's and those given in ``params``) are only guesses.
 

@@ -63,6 +63,11 @@ class CasadiDAE:
     initial: ca.SX = field(default_factory=lambda: ca.SX(0, 1))
     initial_labels: list[str] = field(default_factory=list)
 
+    def __repr__(self) -> str:
+        return (f"CasadiDAE({self.x.numel()} states, {self.z.numel()} algebraic, "
+                f"{len(self.parameters)} parameters, {len(self.inputs)} inputs, "
+                f"{len(self.names)} observed)")
+
     def parameter_values(self, p: np.ndarray) -> dict[str, float]:
         """Every parameter's value for the vector ``p``, bound ones included."""
         names = self.cache.get("parameter names")

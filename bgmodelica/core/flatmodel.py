@@ -154,6 +154,12 @@ class FlatModel:
     #: :attr:`bgmodelica.backends.casadi_dae.CasadiDAE.initial` by the compiler
     initial_equations: list[FlatEquation] = field(default_factory=list)
 
+    def __repr__(self) -> str:
+        """One line with the counts (the variables are in :attr:`variables`)."""
+        return (f"FlatModel({self.name}: {len(self.variables)} variables, "
+                f"{len(self.equations)} equations, {len(self.parameters)} parameters, "
+                f"{len(self.inputs)} inputs, {len(self.aliases)} aliases)")
+
     def stacked_residuals(self) -> ca.SX:
         """Every equation's residual in one SX column, built once while :attr:`equations`
         is the same list (stacking costs a few microseconds per scalar; the passes reuse it)."""

@@ -23,6 +23,7 @@ discrete variables are exported with their FMI types, and the start state is the
 
 from __future__ import annotations
 
+import inspect
 import math
 from pathlib import Path
 
@@ -204,12 +205,24 @@ def fmu_spec(model: Component | CompiledModel, *, stop_time: float = 1.0,
             "init", [t, u, p, d], [f0(t, ca.vertcat(p, u, d))], ["t", "u", "p", "d"], ["x0"])
     else:
         init = _init_function(dae, p_all, t, u, p)
-    return FmuSpec(model_name=name, description=f"{compiled.name} (bgmodelica)",
+    return FmuSpec(model_name=name, description=docstring_summary(compiled),
                    states=state_vars, inputs=inputs, parameters=params, outputs=outputs,
                    state_outputs=[n for n in declared_outputs if n in states],
                    locals=locals_, ode=ode, init=init,
                    stop_time=stop_time,
                    step_size=step_size, tolerance=tolerance, hybrid=hyb_spec)
+
+
+def docstring_summary(compiled: CompiledModel) -> str:
+    """The first paragraph of the model's own docstring (its class's, not inherited), on one
+    line; ``"<name> (bgmodelica)"`` when it has none."""
+    source = compiled.source
+    doc = None
+    if source is not None:
+        doc = type(source).__dict__.get("__doc__") if not isinstance(source, type) \
+            else source.__dict__.get("__doc__")
+    first = " ".join(inspect.cleandoc(doc).split("\n\n")[0].split()) if doc else ""
+    return first or f"{compiled.name} (bgmodelica)"
 
 
 def _init_function(dae, p_all, t, u, p) -> ca.Function | None:

@@ -11,7 +11,9 @@ dependencies from the CasADi sparsity (:func:`bgmodelica.fmi.codegen.dependencie
 * FMI 3.0 refers to value references; ``<Output>``, ``<ContinuousStateDerivative>`` (state order)
   and ``<InitialUnknown>`` follow the same rules.
 
-Dotted names are kept as they are (``variableNamingConvention="structured"``).
+Dotted names are kept as they are (``variableNamingConvention="structured"``). The root's
+``description`` is the first paragraph of the model's docstring and ``generationDateAndTime``
+the export time in UTC (``$SOURCE_DATE_EPOCH`` when set).
 
 Hybrid specs (models with events): discrete variables get their FMI type (Real/Float64,
 Integer/Int32, Boolean); Model Exchange declares the event indicators
@@ -23,7 +25,9 @@ indicator variables in FMI 3.0); FMI 3.0 Co-Simulation may return early from ``f
 from __future__ import annotations
 
 import hashlib
+import os
 import xml.etree.ElementTree as ET
+from datetime import datetime, timezone
 
 from .codegen import Dependencies
 from .spec import FmuSpec
@@ -42,6 +46,16 @@ LOG_CATEGORIES = (
 def _num(value: float) -> str:
     text = repr(float(value))
     return {"inf": "INF", "-inf": "-INF", "nan": "NaN"}.get(text, text)
+
+
+def generation_date() -> str:
+    """Now in UTC as ISO 8601 (``2026-11-28T13:20:00Z``), or the time of
+    ``$SOURCE_DATE_EPOCH`` [s] when set (reproducible builds)."""
+    epoch = os.environ.get("SOURCE_DATE_EPOCH", "").strip()
+    when = datetime.now(timezone.utc)
+    if epoch.isdigit():
+        when = datetime.fromtimestamp(int(epoch), timezone.utc)
+    return when.replace(microsecond=0).strftime("%Y-%m-%dT%H:%M:%SZ")
 
 
 def instantiation_token(*parts: str) -> str:
@@ -169,6 +183,7 @@ def model_description_xml(spec: FmuSpec, table: VariableTable, deps: Dependencie
     if spec.description:
         root.set("description", spec.description)
     root.set("generationTool", GENERATION_TOOL)
+    root.set("generationDateAndTime", generation_date())
     root.set("variableNamingConvention", "structured")
     hybrid = spec.hybrid is not None
     if version == 2:

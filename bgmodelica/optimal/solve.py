@@ -26,7 +26,8 @@ def optimize(model: Any, controls: Mapping[str, Bounds | None] | Sequence[str], 
              params: Mapping[str, Any] | None = None, intervals: int = 40,
              tol: float = 1e-4, max_refinements: int = 4, units: str = "error",
              max_iter: int = 3000) -> OptimalControl:
-    """The controls that steer ``model`` (a component or compiled model) optimally.
+    """The controls that steer ``model`` (a component, compiled model or MODEL reference)
+    optimally.
 
     controls: top-level inputs to optimize, ``{name: (low, high)}`` (None or a list of names:
     unbounded); the inputs not named keep their values (``params``). initial: values of

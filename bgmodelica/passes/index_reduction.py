@@ -43,6 +43,11 @@ class ReducedModel:
     levels: list
     priority: list[int]
 
+    def __repr__(self) -> str:
+        return (f"ReducedModel({self.model.name}: index {self.index}, {len(self.states)} "
+                f"states, {len(self.dummies)} dummy derivatives, "
+                f"{len(self.differentiated)} differentiated equations)")
+
 
 def reduce_index(model: FlatModel | ReducedModel,
                  select: Selector | None = None) -> ReducedModel:

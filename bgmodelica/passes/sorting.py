@@ -56,6 +56,11 @@ class SortedDAE:
     solution_column: ca.SX | None = field(default=None, repr=False)
     positions: list[int] = field(default_factory=list, repr=False)
 
+    def __repr__(self) -> str:
+        return (f"SortedDAE({self.model.name}: {len(self.assignments)} assignments, "
+                f"{len(self.algebraic)} algebraic, {len(self.blocks)} blocks (loops or "
+                "nonlinear))")
+
     def stacked_definitions(self) -> ca.SX:
         """The assignments' expressions as one column, in evaluation order (taken from the
         vectors they were solved in, instead of stacking a scalar per assignment)."""

@@ -200,9 +200,10 @@ def fit(model: Any, data: Any, free: Any, *, params: Mapping[str, Any] | None = 
         units: str = "error") -> FitResult:
     """Estimate the parameters ``free`` of ``model`` from ``data``.
 
-    model: a CompiledModel or a Component. data: one experiment or a list of them (an
-    :class:`Experiment`, a CSV path, a DataFrame, a mapping with ``"time"``). free: parameter
-    names (starting from the model's values), or ``{name: guess}``, or ``{name: (guess, low,
+    model: a CompiledModel, a Component or a MODEL reference (``"library.examples:RC"``).
+    data: one experiment or a list of them (an :class:`Experiment`, a CSV path, a DataFrame,
+    a mapping with ``"time"``). free: parameter names (starting from the model's values), or
+    ``{name: guess}``, or ``{name: (guess, low,
     high)}`` (default bounds: the declared ``min``/``max``). params: fixed overrides for every
     experiment. weights: ``{column: 1/sigma}`` (default 1/RMS of each column). jacobian:
     ``"auto"`` (forward sensitivities, or finite differences for models with events),

@@ -111,10 +111,11 @@ def _rebuild(kind, token, name, blob, ref, kwargs, units) -> ModelPayload:
 
 def payload_for(model: Any, *, ref: str | None = None, kwargs: dict[str, Any] | None = None,
                 units: str = "error", mode: str = "auto") -> ModelPayload:
-    """The payload of ``model``: a CompiledModel, a Component (compiled here, once), or the
-    path of an ``.fmu``. ``ref``/``kwargs``: the model reference it was loaded from, used when
-    ``mode="reference"`` or when pickling fails (``mode="auto"``); ``mode="pickle"`` insists
-    on pickling."""
+    """The payload of ``model``: a CompiledModel, a Component (compiled here, once), a MODEL
+    reference (``"package.module:Name"``, loaded with ``kwargs``) or the path of an ``.fmu``.
+    ``ref``/``kwargs``: the model reference it was loaded from, used when ``mode="reference"`` or
+    when pickling fails (``mode="auto"``); ``mode="pickle"``
+    insists on pickling."""
     from ..compiler import CompiledModel
     from ..compiler import compile as compile_model
     from ..core.component import Component
@@ -124,6 +125,11 @@ def payload_for(model: Any, *, ref: str | None = None, kwargs: dict[str, Any] | 
         token = "fmu-" + hashlib.sha1(data).hexdigest()
         payload = ModelPayload("fmu", token, Path(model).stem, blob=data)
         return payload
+    if isinstance(model, str):                  # a MODEL reference: workers can load it too
+        from ..loader import load_model
+
+        ref, kwargs = model, dict(kwargs or {})
+        model = load_model(ref, **kwargs)
     if isinstance(model, Component):
         model = compile_model(model, units=units)
     if not isinstance(model, CompiledModel):

@@ -126,6 +126,17 @@ class SweepResult:
     def __getitem__(self, name: str) -> Any:
         return self.dataset[name]
 
+    def __repr__(self) -> str:
+        """One line: model, runs, outputs and parameters (the data: :attr:`dataset`)."""
+        attrs = self.dataset.attrs
+
+        def few(names: list[str]) -> str:
+            return ", ".join(names[:3]) + (f", ... ({len(names)})" if len(names) > 3 else "")
+
+        return (f"SweepResult({attrs.get('model', '?')}: {attrs.get('n_runs', '?')} runs, "
+                f"{attrs.get('n_failed', 0)} failed; outputs {few(self.outputs)}; "
+                f"parameters {few(self.parameters)})")
+
     @property
     def outputs(self) -> list[str]:
         return json.loads(self.dataset.attrs["outputs"])
@@ -256,7 +267,9 @@ def sweep(model: Any, grid: Mapping[str, Any] | None = None, samples: int | None
           units: str = "error") -> SweepResult:
     """Run ``model`` over a parameter grid and/or Monte Carlo samples.
 
-    model: a CompiledModel, a Component (compiled once here) or the path of an ``.fmu``.
+    model: a CompiledModel, a Component (compiled once here), a MODEL reference
+    (``"library.examples:RC"``; with ``ref_kwargs``, and workers may load it themselves) or
+    the path of an ``.fmu``.
     grid: ``{name: values}`` (a sequence, ``"start:stop:n"``, ``"start:stop:n:log"`` or
     ``"v1,v2"``), Cartesian product of the axes. samples + distributions: ``samples`` draws of
     ``{name: "normal(3,0.1)" | "uniform(a,b)" | "lognormal(mu,s)" | "triangular(a,m,b)" |

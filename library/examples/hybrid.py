@@ -1,7 +1,7 @@
 """Hybrid example models (events): a bouncing ball, stick-slip friction, a PWM-driven motor.
 
-Each is an acceptance case with fixed parameter and variable names (SI units); see the README
-section on hybrid models for the semantics of events, ``when`` and ``pre``.
+Each is an acceptance case with fixed parameter and variable names (SI units); see
+``docs/guide/hybrid-models.md`` for the semantics of events, ``when`` and ``pre``.
 """
 
 from __future__ import annotations
