@@ -77,9 +77,9 @@ def fmu_spec(model: Component | CompiledModel, *, stop_time: float = 1.0,
     """Describe a model for export (see the module docstring for the conventions).
 
     A model whose state choice must change during a simulation (dynamic state selection,
-    e.g. the Cartesian pendulum) is refused: the FMU runtime keeps the compiled choice, which
-    degenerates. ``static_states=True`` exports it anyway, for motions known to stay where the
-    compiled states are valid."""
+    e.g. the Cartesian pendulum) exports with every candidate choice and switches between
+    them at events (:mod:`bgmodelica.fmi.state_sets`); ``static_states=True`` keeps the
+    compiled choice instead, for motions known to stay where it is valid."""
     compiled = model if isinstance(model, CompiledModel) else compile(model)
     flat = compiled.reduced.model        # first: a model from the array path completes here
     dae = compiled.dae
@@ -89,13 +89,10 @@ def fmu_spec(model: Component | CompiledModel, *, stop_time: float = 1.0,
 
         check_exportable(dae, compiled.name)
     if not static_states and compiled.needs_dynamic_selection():
-        raise FmuSpecError(
-            f"cannot export {compiled.name} as an FMU: it needs dynamic state selection (its "
-            f"states {', '.join(dae.state_names)} are valid only in part of the motion, see "
-            "`bgmodelica check`), which the FMU runtime does not carry, so the FMU would go "
-            "wrong when they degenerate. Give states valid everywhere with state_select, or "
-            "export with static_states=True (--static-states) if the motion stays where "
-            "they are valid")
+        from .state_sets import state_set_spec
+
+        return state_set_spec(compiled, stop_time=stop_time, step_size=step_size,
+                              tolerance=tolerance, newton_tolerance=newton_tolerance)
     n_par = len(dae.parameters)
     p_all = dae.p_default
     if hybrid:

@@ -91,6 +91,9 @@ class HybridSpec:
     step: Any = None
     indicators: Any = None
     samples: Any = None
+    #: the pre() slots also follow their sources after every completed integrator step
+    #: (Newton guesses of dynamic state selection, :mod:`bgmodelica.fmi.state_sets`)
+    track_pre: bool = False
 
     @property
     def nd(self) -> int:
@@ -314,6 +317,7 @@ def header_lines(h: HybridSpec, prefix: str, n_indicator_vars: int) -> list[str]
         f"#define BGM_NZV {n_indicator_vars}",
         f"#define BGM_INITIAL_SLOT {h.initial_slot}",
         f"#define BGM_TERMINAL_SLOT {h.terminal_slot}",
+        f"#define BGM_PRE_TRACKS {int(h.track_pre)}",
         f"#define BGM_CASADI_EVSTEP {prefix}evstep",
         f"#define BGM_CASADI_EVIND {prefix}evind",
         f"#define BGM_CASADI_EVSAMP {prefix}evsamp",
