@@ -41,12 +41,34 @@ THRESHOLD = 0.3          # the native StateSelector's switching threshold
 SLOT_PREFIX = "_stateSet"
 
 
+def _observed(dae, x, z, p, t: float = 0.0) -> np.ndarray:
+    f = ca.Function("observed", [dae.t, dae.x, dae.z, dae.p], [dae.observed])
+    return np.asarray(f(t, x, z, p), dtype=float).ravel()
+
+
+def start_variant(sel: StateSelector) -> CompiledModel:
+    """The selection the native simulation starts with (``_initial_selection``): the pivot
+    test at the base compilation's initial point, undefined values taken at their starts."""
+    base = sel.base
+    dae = base.dae
+    init = initialize(dae, dae.p_default)
+    with np.errstate(all="ignore"):
+        values = _observed(dae, init.x0, init.z0, dae.p_default)[:dae.n_variables]
+    bad = ~np.isfinite(values)
+    if bad.any():
+        starts = [float(getattr(v.decl, "start", 0.0)) for v in base.reduced.model.variables]
+        values[bad] = np.asarray(starts)[bad]
+    return sel.check(base, values, dae.p_default, 0.0)
+
+
 def variants(compiled: CompiledModel, samples: int = 400, seed: int = 0
              ) -> list[CompiledModel]:
-    """The base compilation and every other selection the native pivot test picks as best at
-    ``samples`` random points (deterministic)."""
+    """The selection the native simulation starts with, then the base compilation and every
+    other selection the native pivot test picks as best at ``samples`` random points
+    (deterministic)."""
     sel = StateSelector(compiled)
-    out = {sel.key(compiled.reduced.dummies): compiled}
+    first = start_variant(sel)
+    out = {sel.key(first.reduced.dummies): first, sel.key(compiled.reduced.dummies): compiled}
     rng = np.random.default_rng(seed)
     n = len(compiled.reduced.model.variables)
     p = compiled.dae.p_default
@@ -187,12 +209,12 @@ class StateSetExport:
 
     # ------------------------------------------------------------------ spec parts
     def init_function(self) -> ca.Function | None:
-        """``(t, u, p, d) -> x0`` of the base variant when the initial state follows from
+        """``(t, u, p, d) -> x0`` of the first variant when the initial state follows from
         conditions through the equations (as :func:`~bgmodelica.fmi.from_model.fmu_spec`)."""
         from ..backends.casadi_init import initial_state_function
 
-        base = self.compiled.dae
-        f0 = initial_state_function(base, base.p_default)
+        first = self.variants[0].dae
+        f0 = initial_state_function(first, first.p_default)
         if f0 is None:
             return None
         t, u = ca.MX.sym("t"), ca.MX.sym("u", self.nu)
@@ -201,14 +223,11 @@ class StateSetExport:
                            ["t", "u", "p", "d"], ["x0"])
 
     def start(self) -> tuple[np.ndarray, list[float]]:
-        """Consistent initial states of the base variant and the start of the slots."""
-        base = self.compiled.dae
-        init = initialize(base, base.p_default)
-        values = {n: float(v) for n, v in zip(
-            base.names, np.asarray(ca.Function("o", [base.t, base.x, base.z, base.p],
-                                               [base.observed])(0.0, init.x0, init.z0,
-                                                                base.p_default)).ravel(),
-            strict=True)}
+        """Consistent initial states of the first variant and the start of the slots."""
+        first = self.variants[0].dae
+        init = initialize(first, first.p_default)
+        values = dict(zip(first.names, _observed(first, init.x0, init.z0, first.p_default),
+                          strict=True))
         d = [0.0, 1.0, 0.0]
         for v in self.variants:
             d += [values.get(n, 0.0) for n in v.dae.algebraic_names]
