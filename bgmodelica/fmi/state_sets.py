@@ -247,7 +247,7 @@ class StateSetExport:
         assigns, reinits = [], []
         apos = rpos = 0
         per = []
-        for j, v in enumerate(self.variants):
+        for j in range(self.n_var):
             a = [(0, apos)] + [(s, apos + 1 + i) for i, s in enumerate(self.z_slot[j])]
             r = [(i, 1.0, rpos + i) for i in range(self.nx)]
             apos += 1 + len(self.z_slot[j])
