@@ -78,9 +78,11 @@ def fmu_spec(model: Component | CompiledModel, *, stop_time: float = 1.0,
     """Describe a model for export (see the module docstring for the conventions).
 
     A model whose state choice must change during a simulation (dynamic state selection,
-    e.g. the Cartesian pendulum) is refused: the FMU runtime keeps the compiled choice, which
-    degenerates. ``static_states=True`` exports it anyway, for motions known to stay where the
-    compiled states are valid."""
+    e.g. the Cartesian pendulum) exports with every candidate choice and switches between
+    them at events (:mod:`bgmodelica.fmi.state_sets`); ``static_states=True`` keeps the
+    compiled choice instead, for motions known to stay where it is valid. A model with events
+    of its own keeps the choice the native simulation starts with (PendulumWall: the
+    preferred ``x, vx``, which the native simulation keeps too)."""
     compiled = model if isinstance(model, CompiledModel) else compile(model)
     flat = compiled.reduced.model        # first: a model from the array path completes here
     dae = compiled.dae
@@ -90,13 +92,17 @@ def fmu_spec(model: Component | CompiledModel, *, stop_time: float = 1.0,
 
         check_exportable(dae, compiled.name)
     if not static_states and compiled.needs_dynamic_selection():
-        raise FmuSpecError(
-            f"cannot export {compiled.name} as an FMU: it needs dynamic state selection (its "
-            f"states {', '.join(dae.state_names)} are valid only in part of the motion, see "
-            "`bgmodelica check`), which the FMU runtime does not carry, so the FMU would go "
-            "wrong when they degenerate. Give states valid everywhere with state_select, or "
-            "export with static_states=True (--static-states) if the motion stays where "
-            "they are valid")
+        from .state_sets import start_variant, state_set_spec
+
+        if not hybrid:
+            return state_set_spec(compiled, stop_time=stop_time, step_size=step_size,
+                                  tolerance=tolerance, newton_tolerance=newton_tolerance)
+        # with events: the selection the native simulation starts with, kept (open: the
+        # switch between selections in an FMU with events of its own)
+        from ..dynamic_selection import StateSelector
+
+        compiled = start_variant(StateSelector(compiled))
+        flat, dae = compiled.reduced.model, compiled.dae
     n_par = len(dae.parameters)
     p_all = dae.p_default
     if hybrid:

@@ -16,9 +16,11 @@ local: those assigned in ``when`` clauses with ``initial="exact"`` and their dec
 equations (e.g. ``diode.off``) as ``initial="calculated"``. Table data are compiled into the
 C code (``bgm_hybrid_data.c``).
 
-Not exported (refused with :class:`~bgmodelica.fmi.spec.FmuSpecError`): ``reinit`` of a
-variable that index reduction demoted from the states (the native loop re-initializes it by
-a nonlinear solve).
+``reinit`` of a variable that index reduction demoted from the states (the pendulum's ``vy``
+when ``x, vx`` are the states) re-initializes the states consistently as the native loop does:
+the re-initialized variables are fixed and the states they determine are solved with the
+model's algebraic equations (a code-generatable Newton solve from the values before the
+event); the event sets those states.
 """
 
 from __future__ import annotations
@@ -91,6 +93,9 @@ class HybridSpec:
     step: Any = None
     indicators: Any = None
     samples: Any = None
+    #: the pre() slots also follow their sources after every completed integrator step
+    #: (Newton guesses of dynamic state selection, :mod:`bgmodelica.fmi.state_sets`)
+    track_pre: bool = False
 
     @property
     def nd(self) -> int:
@@ -127,18 +132,49 @@ def indicator_name(k: int) -> str:
 
 
 def check_exportable(dae: CasadiDAE, name: str) -> None:
-    """Refuse what the FMU runtime cannot reproduce (with the reason)."""
-    fn = build(dae)
-    for branch in fn.reinit_of:
-        for var, _ in branch:
-            rep = dae.aliases.get(var, (var, 1.0))[0]
-            if rep not in dae.state_names:
-                raise FmuSpecError(
-                    f"cannot export {name} as an FMU: reinit({var}, ...) restarts a variable "
-                    "that index reduction demoted from the states (the native simulation "
-                    "re-initializes the states consistently with a nonlinear solve, which the "
-                    "FMU's event runtime does not carry); the FMU can restart its states "
-                    f"({', '.join(dae.state_names)}) only")
+    """Refuse what the FMU runtime cannot reproduce (with the reason); every reinit target
+    must be a state or a variable the states determine (checked when the events are built)."""
+    build(dae)
+
+
+def _consistent_reinit(dae: CasadiDAE, branch: list[tuple[str, int]], t, x, z, pfull,
+                       reinit) -> tuple[list[int], ca.MX]:
+    """A reinit branch that restarts variables demoted from the states: the native
+    consistent re-initialization (``HybridSimulator._consistent`` with the re-initialized
+    variables fixed), as a code-generatable Newton solve started from the values before the
+    event. Returns the states it sets and their values."""
+    from ..backends.casadi_init import init_structure
+
+    pinned_value: dict[int, ca.MX] = {}
+    fixed, cond_value = [], {}
+    for var, pos in branch:
+        rep, sign = dae.aliases.get(var, (var, 1.0))
+        value = sign * reinit[pos]
+        k = dae.observed_index[rep]
+        fixed.append((k, 0.0))
+        if rep in dae.state_names:
+            pinned_value[dae.state_names.index(rep)] = value
+        else:
+            cond_value[k] = value
+    st = init_structure(replace(dae, fixed=fixed, initial=dae.initial[:0],
+                                initial_labels=[]))
+    conds = [k for k, _ in st.conditions]
+    pinned = [i for i in range(dae.x.numel()) if i not in set(st.free)]
+    vals = ca.SX.sym("vals", len(conds))
+    unknown = ca.vertcat(*[dae.x[i] for i in st.free], dae.z)
+    known = ca.vertcat(*[dae.x[i] for i in pinned]) if pinned else ca.SX(0, 1)
+    res = ca.vertcat(*[dae.observed[k] - vals[j] for j, k in enumerate(conds)], dae.alg)
+    g = ca.Function("reinit_g", [unknown, ca.vertcat(known, dae.p, dae.t, vals)], [res])
+    solver = ca.rootfinder("reinit_solve", "fast_newton", g,
+                           {"abstol": 1e-12, "max_iter": 50})
+    known_v = ca.vertcat(*[pinned_value.get(i, x[i]) for i in pinned]) if pinned \
+        else ca.MX(0, 1)
+    w = solver(ca.vertcat(*[x[i] for i in st.free], z),
+               ca.vertcat(known_v, pfull, t, *[cond_value[k] for k in conds]))
+    states = sorted(set(st.free) | set(pinned_value))
+    value_of = {i: w[j] for j, i in enumerate(st.free)}
+    value_of.update(pinned_value)
+    return states, ca.vertcat(*[value_of[i] for i in states])
 
 
 def consistent_start(dae: CasadiDAE, p: np.ndarray):
@@ -218,8 +254,6 @@ def build_hybrid(dae: CasadiDAE, flat, by_name: dict, z_of, pfull_of) -> HybridS
     g, dgdt, cond, assign, reinit, pre, _obs = fn.step(t, x, z, pfull)
     dv = dv_f(t, x, z, pfull)
     args, names = [t, x, u, p, d], ["t", "x", "u", "p", "d"]
-    step = ca.Function("evstep", args, [g, dgdt, cond, assign, reinit, pre, dv], names,
-                       ["g", "dgdt", "cond", "assign", "reinit", "pre", "dv"])
     # relations on inputs (constant for the native loop, which feeds inputs as time tables)
     # change with the importer's inputs: state events in the FMU
     u_sx = dae.p[np_:nb]
@@ -237,13 +271,21 @@ def build_hybrid(dae: CasadiDAE, flat, by_name: dict, z_of, pfull_of) -> HybridS
     samp_f = ca.Function("samp", [dae.p], [ca.densify(samp)])
     samples = ca.Function("evsamp", args, [samp_f(pfull)], names, ["samples"])
 
-    reinits = []
+    reinits, extra = [], [reinit]
+    n_reinit = reinit.numel()
     for branch in fn.reinit_of:
-        row = []
-        for var, pos in branch:
-            rep, sign = dae.aliases.get(var, (var, 1.0))
-            row.append((dae.state_names.index(rep), float(sign), pos))
-        reinits.append(row)
+        reps = [dae.aliases.get(var, (var, 1.0)) for var, _ in branch]
+        if all(rep in dae.state_names for rep, _ in reps):
+            reinits.append([(dae.state_names.index(rep), float(sign), pos)
+                            for (rep, sign), (_, pos) in zip(reps, branch, strict=True)])
+            continue
+        states, values = _consistent_reinit(dae, branch, t, x, z, pfull, reinit)
+        reinits.append([(i, 1.0, n_reinit + j) for j, i in enumerate(states)])
+        extra.append(values)
+        n_reinit += len(states)
+    reinit = ca.vertcat(*extra)
+    step = ca.Function("evstep", args, [g, dgdt, cond, assign, reinit, pre, dv], names,
+                       ["g", "dgdt", "cond", "assign", "reinit", "pre", "dv"])
     tables = [TableData(tb.c0, tb.c1, tuple(float(v) for v in np.asarray(tb.times).ravel()),
                         tuple(float(v) for v in np.asarray(tb.values).ravel()),
                         tb.interpolation == "hold", tb.extrapolation,
@@ -306,6 +348,8 @@ def header_lines(h: HybridSpec, prefix: str, n_indicator_vars: int) -> list[str]
         f"#define BGM_NCOND {n_cond}",
         f"#define BGM_NASSIGN {sum(len(b) for b in h.assigns)}",
         f"#define BGM_NREINIT {sum(len(b) for b in h.reinits)}",
+        f"#define BGM_NASSIGNV {h.step.numel_out(3)}",
+        f"#define BGM_NREINITV {h.step.numel_out(4)}",
         f"#define BGM_NPRE {len(h.pre)}",
         f"#define BGM_NSAMP {len(h.sample_slots)}",
         f"#define BGM_NTAB {len(h.tables)}",
@@ -314,6 +358,7 @@ def header_lines(h: HybridSpec, prefix: str, n_indicator_vars: int) -> list[str]
         f"#define BGM_NZV {n_indicator_vars}",
         f"#define BGM_INITIAL_SLOT {h.initial_slot}",
         f"#define BGM_TERMINAL_SLOT {h.terminal_slot}",
+        f"#define BGM_PRE_TRACKS {int(h.track_pre)}",
         f"#define BGM_CASADI_EVSTEP {prefix}evstep",
         f"#define BGM_CASADI_EVIND {prefix}evind",
         f"#define BGM_CASADI_EVSAMP {prefix}evsamp",

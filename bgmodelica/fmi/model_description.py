@@ -186,6 +186,8 @@ def model_description_xml(spec: FmuSpec, table: VariableTable, deps: Dependencie
     root.set("generationDateAndTime", generation_date())
     root.set("variableNamingConvention", "structured")
     hybrid = spec.hybrid is not None
+    # the Newton guesses of dynamic state selection follow the completed steps
+    needs_step = "true" if hybrid and spec.hybrid.track_pre else "false"
     if version == 2:
         n_ind = spec.hybrid.nz if hybrid and "me" in interfaces else 0
         root.set("numberOfEventIndicators", str(n_ind))
@@ -196,7 +198,8 @@ def model_description_xml(spec: FmuSpec, table: VariableTable, deps: Dependencie
                 "true"}
         if "me" in interfaces:
             me = ET.SubElement(root, "ModelExchange", modelIdentifier=model_identifier,
-                               completedIntegratorStepNotNeeded="true", **caps)
+                               completedIntegratorStepNotNeeded="false" if needs_step == "true"
+                               else "true", **caps)
             _source_files(me, source_files)
         if "cs" in interfaces:
             cs = ET.SubElement(root, "CoSimulation", modelIdentifier=model_identifier,
@@ -209,7 +212,7 @@ def model_description_xml(spec: FmuSpec, table: VariableTable, deps: Dependencie
                 "providesDirectionalDerivatives": "true"}
         if "me" in interfaces:
             ET.SubElement(root, "ModelExchange", modelIdentifier=model_identifier,
-                          needsCompletedIntegratorStep="false", **caps)
+                          needsCompletedIntegratorStep=needs_step, **caps)
         if "cs" in interfaces:
             early = {"mightReturnEarlyFromDoStep": "true"} if hybrid else {}
             ET.SubElement(root, "CoSimulation", modelIdentifier=model_identifier,

@@ -253,6 +253,7 @@ bgm_status bgm_hyb_update(bgm_inst *c, const char *fn, int *need_update, int *x_
 bgm_status bgm_hyb_terminate(bgm_inst *c, const char *fn);
 bgm_status bgm_hyb_event_indicators(bgm_inst *c, const char *fn, double z[], size_t ni);
 bgm_status bgm_hyb_integrate(bgm_inst *c, const char *fn, double t_end);
+void bgm_hyb_track(bgm_inst *c, double t, const double *x);
 int bgm_hyb_step_check(bgm_inst *c, double t0, const double *x0, double t1, const double *x1);
 bgm_status bgm_hyb_value(bgm_inst *c, const char *fn, int kind, size_t i, int type,
                          int *evaluated, double *value);

@@ -542,10 +542,25 @@ bgm_status bgm_hyb_event_indicators(bgm_inst *c, const char *fn, double z[], siz
 
 /* ------------------------------------------------------------------- Co-Simulation */
 
+/* after a completed integrator step: the pre() slots that follow their sources between
+   events (BGM_PRE_TRACKS: the Newton guesses of dynamic state selection) take their values */
+void bgm_hyb_track(bgm_inst *c, double t, const double *x) {
+#if BGM_PRE_TRACKS
+    if (!c->v.h.initialized || ev_step(c, t, x)) return;
+    ev_set_pre(c);
+    c->cache_valid = 0;
+#else
+    (void)c;
+    (void)t;
+    (void)x;
+#endif
+}
+
 /* called by the solver after each accepted step (before it is committed) */
 int bgm_hyb_step_check(bgm_inst *c, double t0, const double *x0, double t1, const double *x1) {
     bgm_hyb_work *w = &c->hw;
     if (!w->check || BGM_NZ == 0) return 0;
+    bgm_hyb_track(c, t1, x1);
     if (ev_ind(c, t1, x1, w->hi_g) || !ev_changed(c, w->hi_g)) return 0;
     if (ev_ind(c, t0, x0, w->lo_g)) return 0;
     w->lo_t = t0;

@@ -28,6 +28,8 @@
 #define BGM_NWHENA (BGM_NWHEN > 0 ? BGM_NWHEN : 1)
 #define BGM_NCONDA (BGM_NCOND > 0 ? BGM_NCOND : 1)
 #define BGM_NASSIGNA (BGM_NASSIGN > 0 ? BGM_NASSIGN : 1)
+#define BGM_NASSIGNVA (BGM_NASSIGNV > 0 ? BGM_NASSIGNV : 1) /* values: evstep's assign */
+#define BGM_NREINITVA (BGM_NREINITV > 0 ? BGM_NREINITV : 1) /* values: evstep's reinit */
 #define BGM_NREINITA (BGM_NREINIT > 0 ? BGM_NREINIT : 1)
 #define BGM_NPREA (BGM_NPRE > 0 ? BGM_NPRE : 1)
 #define BGM_NSAMPA (BGM_NSAMP > 0 ? BGM_NSAMP : 1)
@@ -63,8 +65,8 @@ typedef struct {
 
 /* Scratch memory of the event functions (not part of the FMU state). */
 typedef struct {
-    double g[BGM_NRELA], dgdt[BGM_NRELA], cond[BGM_NCONDA], assign[BGM_NASSIGNA];
-    double reinit[BGM_NREINITA], pre[BGM_NPREA], dv[BGM_NDVA];
+    double g[BGM_NRELA], dgdt[BGM_NRELA], cond[BGM_NCONDA], assign[BGM_NASSIGNVA];
+    double reinit[BGM_NREINITVA], pre[BGM_NPREA], dv[BGM_NDVA];
     double z[BGM_NZA], vals[BGM_NRELA], samp[2 * BGM_NSAMPA];
     double xnew[BGM_NXA], xc[BGM_NXA], zc[BGM_NZA];
     /* Co-Simulation: bracket of a state event found by the solver */

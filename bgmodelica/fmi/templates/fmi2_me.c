@@ -77,6 +77,9 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component c,
     }
     *enterEventMode = fmi2False;
     *terminateSimulation = fmi2False;
+#if BGM_HYBRID
+    bgm_hyb_track(INST, INST->v.time, INST->v.x);
+#endif
     return fmi2OK;
 }
 

@@ -32,6 +32,9 @@ fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance,
     }
     *enterEventMode = fmi3False;
     *terminateSimulation = fmi3False;
+#if BGM_HYBRID
+    bgm_hyb_track(INST, INST->v.time, INST->v.x);
+#endif
     return fmi3OK;
 }
 
