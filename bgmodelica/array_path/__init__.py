@@ -1,7 +1,8 @@
 """The array path: large models compiled without a Python object per scalar.
 
 Two kinds of model take it: a leaf model of array equations (:mod:`.collect`), and a model
-of many leaf components joined by ``connect`` (:mod:`.components`, its connection sets as
+of components, flat or hierarchical, joined by ``connect`` (:mod:`.components`, its
+identical leaves written once across their parents, its connection sets as
 linear rows: :mod:`.connections`). ``compile`` sends a model here first
 (:func:`compile_arrays`). A model it takes is lowered to MX blocks (:mod:`.lowering`), its
 aliases eliminated (:mod:`.aliases`), ordered on its integer incidence

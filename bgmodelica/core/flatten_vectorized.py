@@ -114,26 +114,57 @@ def component_groups(elem: Component) -> list[tuple[list[str], list[Any]]]:
     rest, the components of one class when there are :data:`GROUP_FROM` or more (a
     component per section of a ladder). Each group as ``(child names, children)``."""
     children = elem._children
+    out = _array_groups(elem, "")
+    if len(children) >= GROUP_FROM:
+        taken = {id(c) for _, items in out for c in items}
+        out += _class_groups((key, child) for key, child in children.items()
+                             if isinstance(child, Component) and id(child) not in taken)
+    return out
+
+
+def tree_groups(components: dict[str, Any], parents: list[tuple[str, Component]],
+                ) -> list[tuple[list[str], list[Any]]]:
+    """:func:`component_groups` across a whole tree: the arrays of components of every
+    parent (``parents``: the components holding components, by path, in tree order), then,
+    among the other components without subcomponents (``components``: all but the top
+    level, by path, in tree order), those of one class when there are :data:`GROUP_FROM` or
+    more, wherever they sit (the resistor of each section of a ladder of sections). Each
+    group as ``(paths, components)``; for a flat model, ``component_groups(top)``."""
+    out: list[tuple[list[str], list[Any]]] = []
+    for path, parent in parents:
+        out += _array_groups(parent, f"{path}." if path else "")
+    taken = {id(c) for _, items in out for c in items}
+    out += _class_groups((path, child) for path, child in components.items()
+                         if id(child) not in taken and isinstance(child, Component)
+                         and not any(isinstance(c, Component)
+                                     for c in child._children.values()))
+    return out
+
+
+def _array_groups(elem: Component, prefix: str) -> list[tuple[list[str], list[Any]]]:
+    """The arrays of components of ``elem`` (two elements or more), names after
+    ``prefix``."""
     arrays: dict[str, tuple[list[str], list[Any]]] = {}
     if "_arrays" in elem.__dict__:
-        for key, child in children.items():
+        for key, child in elem._children.items():
             if key[-1] == "]" and isinstance(child, Component):
                 base, _, index = key[:-1].partition("[")
                 if index.isdigit():
                     names, items = arrays.setdefault(base, ([], []))
-                    names.append(key)
+                    names.append(prefix + key)
                     items.append(child)
-    out = [group for group in arrays.values() if len(group[1]) > 1]
-    if len(children) >= GROUP_FROM:
-        taken = {id(c) for _, items in out for c in items}
-        by_class: dict[type, tuple[list[str], list[Any]]] = {}
-        for key, child in children.items():
-            if isinstance(child, Component) and id(child) not in taken:
-                names, items = by_class.setdefault(type(child), ([], []))
-                names.append(key)
-                items.append(child)
-        out += [group for group in by_class.values() if len(group[1]) >= GROUP_FROM]
-    return out
+    return [group for group in arrays.values() if len(group[1]) > 1]
+
+
+def _class_groups(members: Any) -> list[tuple[list[str], list[Any]]]:
+    """``(name, component)`` pairs grouped by class, the groups of :data:`GROUP_FROM` or
+    more in the order of their first member."""
+    by_class: dict[type, tuple[list[str], list[Any]]] = {}
+    for key, child in members:
+        names, items = by_class.setdefault(type(child), ([], []))
+        names.append(key)
+        items.append(child)
+    return [group for group in by_class.values() if len(group[1]) >= GROUP_FROM]
 
 
 def array_equations(items: list[Any],
