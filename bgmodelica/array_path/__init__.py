@@ -238,11 +238,22 @@ class _Variables(Sequence):
         """Name -> declared unit, without an item per variable."""
         return dict(zip(self.names, map(_UNIT, map(_DECL, self.symbols)), strict=True))
 
-    def lookup(self, names: set[str]) -> dict[str, Declared]:
-        """The variables of these names (name -> item; names not found are left out)."""
+    def declarations(self, names: set[str]) -> dict[str, Any]:
+        """The declarations of these names (name -> declaration; names not found are left
+        out), without an item per variable."""
+        index = self._index_of()
+        symbols = self.symbols
+        return {name: symbols[index[name]].decl for name in names if name in index}
+
+    def _index_of(self) -> dict[str, int]:
         index = self.__dict__.get("_index")
         if index is None:
             index = self._index = dict(zip(self.names, range(len(self.names)), strict=True))
+        return index
+
+    def lookup(self, names: set[str]) -> dict[str, Declared]:
+        """The variables of these names (name -> item; names not found are left out)."""
+        index = self._index_of()
         return {name: self[index[name]] for name in names if name in index}
 
 
