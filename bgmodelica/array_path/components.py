@@ -31,7 +31,12 @@ from ..core.expr import Equation
 from ..core.flatmodel import EquationSources
 from ..core.flatten import _side_shape
 from ..core.flatten_connections import connection_set_arrays
-from ..core.flatten_vectorized import array_equations, tree_groups
+from ..core.flatten_vectorized import (
+    _class_groups,
+    array_equations,
+    group_connections,
+    tree_groups,
+)
 from ..core.variables import TIME
 from .collect import Collected
 from .columns import Columns, memo_of
@@ -56,7 +61,7 @@ def collect_components(model: Component, minimum: int) -> Any:
     cols = Columns(elements, [items for items, _ in equations.groups])
     if cols.refused is not None:
         return cols.refused
-    rows = _connections(equations.links, equations.sides, cols)
+    rows = _connections(equations.ends, equations.sides, cols)
     if isinstance(rows, str):
         return rows
     all_equations = [*rows, *equations.items]
@@ -128,10 +133,11 @@ def _tree(model: Component, minimum: int) -> _Tree | str:
 
 class _Equations:
     """The model's equations in the scalar pipeline's order: the groups of components
-    written once, then the others' one by one in tree order; ``links`` are the
-    connections of every level (``sides``: whether each end is seen from outside its
-    component, i.e. connected inside it), ``refused`` says why the model goes the scalar
-    way."""
+    written once, then the others' one by one in tree order; the connections of every
+    level in tree order, as their ends (``ends``: two lists) and whether each end is seen
+    from outside its component, i.e. connected inside it (``sides``); the connections of
+    many composites of one class are written once too. ``refused`` says why the model goes
+    the scalar way."""
 
     def __init__(self, model: Component, tree: _Tree, where: str) -> None:
         from ..validate import guarded_equations
@@ -141,9 +147,11 @@ class _Equations:
         self.arrays: list[tuple[ArrayEquation, str, list[str] | None]] = []
         self.refused: str | None = None
         self.groups: list[tuple[list[Any], dict]] = []     # (components, arrays they read)
-        self.links: list[Connection] = []
+        self.ends: tuple[list[Any], list[Any]] = ([], [])
         self.sides: list[tuple[bool, bool]] = []
-        if not self._level(model, guarded_equations(model, where, "", blocks=True), where):
+        self._rank: list[np.ndarray] = []           # each link's (component, place)
+        place = {id(c): k for k, c in enumerate(tree.components.values(), start=1)}
+        if not self._level(model, guarded_equations(model, where, "", blocks=True), where, 0):
             return
         done: set[int] = set()
         for names, items in tree_groups(tree.components, tree.parents):
@@ -158,17 +166,32 @@ class _Equations:
             self.items.extend(eqs)
             self.arrays.extend((eq, origin, wheres) for eq in eqs)
             done.update(map(id, items))
+        for _, items in _class_groups((path, c) for path, c in tree.parents if c is not model):
+            pairs = group_connections(items)
+            if pairs is None:
+                continue
+            at = np.fromiter(map(place.__getitem__, map(id, items)), np.int64, len(items))
+            own = items[0]._children
+            for j, (a, b) in enumerate(pairs):
+                self.ends[0].extend(a._items)
+                self.ends[1].extend(b._items)
+                ends = (own.get(a._items[0]._name) is a._items[0],
+                        own.get(b._items[0]._name) is b._items[0])
+                self.sides.extend([ends] * len(items))
+                self._rank.append(np.column_stack((at, np.full(at.size, j))))
+            done.update(map(id, items))
         for path, child in tree.components.items():
             if id(child) in done:
                 continue
             where = f"{path} ({type(child).__name__})"
             if not self._level(child, guarded_equations(child, where, path, blocks=True),
-                               where):
+                               where, place[id(child)]):
                 return
+        self._tree_order()
 
-    def _level(self, elem: Component, equations: list[Any], where: str) -> bool:
-        """Add the connections and equations of one component (False, with ``refused`` set,
-        if they are not for the array path)."""
+    def _level(self, elem: Component, equations: list[Any], where: str, at: int) -> bool:
+        """Add the connections and equations of one component, ``at`` its place in the tree
+        (False, with ``refused`` set, if they are not for the array path)."""
         links = [eq for eq in equations if type(eq) is Connection]
         if not links:
             return self._take(equations, where)
@@ -177,11 +200,27 @@ class _Equations:
                 f"{where} connects signals"
             return False
         own = elem._children
-        self.links.extend(links)
+        self.ends[0].extend(map(_A, links))
+        self.ends[1].extend(map(_B, links))
         self.sides.extend((own.get(eq.a._name) is eq.a, own.get(eq.b._name) is eq.b)
                           for eq in links)
+        self._rank.append(np.column_stack((np.full(len(links), at),
+                                           np.arange(len(links)))))
         return len(links) == len(equations) or self._take(
             [eq for eq in equations if type(eq) is not Connection], where)
+
+    def _tree_order(self) -> None:
+        """The connections in the order the scalar pipeline meets them: by component in
+        tree order, then as written."""
+        if not self._rank:
+            return
+        rank = np.concatenate(self._rank)
+        order = np.lexsort((rank[:, 1], rank[:, 0]))
+        if (order[1:] > order[:-1]).all():
+            return
+        self.ends = (list(map(self.ends[0].__getitem__, order)),
+                     list(map(self.ends[1].__getitem__, order)))
+        self.sides = list(map(self.sides.__getitem__, order))
 
     def _take(self, equations: list[Any], where: str) -> bool:
         """Add the equations of one component (False, with ``refused`` set, if they are not
@@ -232,17 +271,17 @@ def _smooth(shape: Any) -> bool:
     return shape[0] in _SMOOTH_OPS and all(map(_smooth, shape[1:]))
 
 
-def _connections(links: list[Connection], sides: list[tuple[bool, bool]],
+def _connections(ends: tuple[list[Any], list[Any]], sides: list[tuple[bool, bool]],
                  cols: Columns) -> list[Any] | str:
     """The connection sets' equations as linear rows, or why they go the scalar way
-    (``sides``: whether each link's ends are connected from inside their component)."""
+    (``ends``: the connections' first and second connectors; ``sides``: whether each is
+    connected from inside its component)."""
     index = cols.connector
     n_c = len(cols.paths)
+    n_links = len(sides)
     try:
-        heads = np.fromiter(map(index.__getitem__, map(id, map(_B, links))), np.int64,
-                            len(links))
-        tails = np.fromiter(map(index.__getitem__, map(id, map(_A, links))), np.int64,
-                            len(links))
+        heads = np.fromiter(map(index.__getitem__, map(id, ends[1])), np.int64, n_links)
+        tails = np.fromiter(map(index.__getitem__, map(id, ends[0])), np.int64, n_links)
     except KeyError:
         return "a connection uses a connector that is not part of the model"
     if (heads == tails).any():

@@ -28,7 +28,7 @@ import numpy as np
 
 from .array_marks import mark_leaves
 from .arrays import ArrayEquation, ArrayExpr
-from .component import Component, Connector, _own_methods
+from .component import Component, Connection, Connector, _own_methods, check_connectable
 from .expr import Leaf
 
 #: plain attribute values a view hands out when every element has the same one
@@ -45,11 +45,15 @@ _SYM, _DECL, _UNIT = attrgetter("sym"), attrgetter("decl"), attrgetter("unit")
 class _View:
     """Elements of one class seen as one: attributes are arrays of the elements' ones."""
 
-    __slots__ = ("_items", "_seen")
+    __slots__ = ("_items", "_seen", "_deep")
+    #: ``connect`` of two views is one :class:`~.component.Connection` of them
+    _group_view = True
 
-    def __init__(self, items: list[Any]) -> None:
+    def __init__(self, items: list[Any], deep: bool = False) -> None:
+        """``deep``: subcomponents are views too (not only connectors)."""
         object.__setattr__(self, "_items", items)
         object.__setattr__(self, "_seen", {})     # name -> array or view, made once
+        object.__setattr__(self, "_deep", deep)
 
     def __getattr__(self, name: str) -> Any:
         seen = self._seen.get(name)
@@ -84,8 +88,8 @@ class _View:
                         and len(set(map(_UNIT, decls))) == 1)
             found = self._seen[name] = ArrayExpr(arr)
             return found
-        if isinstance(first, Connector):
-            found = self._seen[name] = _View(values)
+        if isinstance(first, Connector) or (self._deep and isinstance(first, Component)):
+            found = self._seen[name] = _View(values, self._deep)
             return found
         if isinstance(first, _PLAIN) and all(type(v) is type(first) and v == first
                                              for v in values):
@@ -202,6 +206,33 @@ def array_equations(items: list[Any],
             else:
                 arrays.update(((name, key), found) for key, found in seen._seen.items()
                               if isinstance(found, ArrayExpr))
+    return out
+
+
+def group_connections(items: list[Any]) -> list[tuple[Any, Any]] | None:
+    """The ``connect`` statements of components ``items`` (of one class, holding exactly
+    its declarations, subcomponents and connectors), written once for all of them: pairs
+    of connector views (their ``_items`` are the ends, member by member), or None when
+    their equations are not only connections the view can answer."""
+    first = items[0]
+    if len(items) < 2 or any(map(_EQUATIONS, items)) or not _as_declared(items):
+        return None
+    view = _View(items, deep=True)
+    out: list[tuple[Any, Any]] = []
+    try:
+        for own in _own_methods(type(first), "equations"):
+            result = own(view)
+            if result is None:
+                continue
+            for eq in result:
+                if type(eq) is not Connection or type(eq.a) is not _View \
+                        or type(eq.b) is not _View or not isinstance(eq.a, Connector) \
+                        or not isinstance(eq.b, Connector):
+                    return None
+                check_connectable(eq.a._items[0], eq.b._items[0])
+                out.append((eq.a, eq.b))
+    except Exception:  # noqa: BLE001 -- anything the view cannot answer: one by one instead
+        return None
     return out
 
 
