@@ -233,18 +233,35 @@ def _finite_run(dae: CasadiDAE, obs_idx: list[int], times: np.ndarray, xs: np.nd
     elif 4 * len(obs_idx) < len(dae.names):     # a few outputs: analyse only those
         key = ("unsafe_of", tuple(obs_idx))
         if key not in dae.cache:
-            f = ca.Function("observed", [dae.t, dae.x, dae.z, dae.p],
-                            [ca.densify(dae.observed[obs_idx])])
-            dae.cache[key] = [obs_idx[k] for k in unsafe_outputs(f, (0, 1, 2))]
+            dae.cache[key] = _unsafe(dae, obs_idx)
         unsafe = dae.cache[key]
     else:
-        f = ca.Function("observed", [dae.t, dae.x, dae.z, dae.p], [ca.densify(dae.observed)])
-        dae.cache["unsafe_observed"] = set(unsafe_outputs(f, (0, 1, 2)))
+        dae.cache["unsafe_observed"] = set(_unsafe(dae, range(len(dae.names))))
         unsafe = [k for k in obs_idx if k in dae.cache["unsafe_observed"]]
     if not unsafe or not len(times):
         return True
     with np.errstate(all="ignore"):
         return bool(np.all(np.isfinite(_observer(dae, unsafe)(times, xs, zs, p))))
+
+
+def _unsafe(dae: CasadiDAE, idx: Sequence[int]) -> list[int]:
+    """The observed variables ``idx`` that can turn non-finite for finite states
+    (:func:`bgmodelica.diagnose.unsafe_outputs`). Only those nonlinear in time, states or
+    algebraic variables are analysed (a division, root, logarithm or power of something
+    varying is nonlinear in it; the others are linear in what varies), found in one
+    structural pass (:func:`casadi.which_depends`, second order)."""
+    idx = list(idx)
+    if not idx:
+        return []
+    expr = dae.observed[idx]
+    varying = ca.vertcat(dae.t, dae.x, dae.z)
+    nonlinear = [k for k, yes in zip(idx, ca.which_depends(expr, varying, 2, True),
+                                     strict=True) if yes]
+    if not nonlinear:
+        return []
+    f = ca.Function("observed", [dae.t, dae.x, dae.z, dae.p],
+                    [ca.densify(dae.observed[nonlinear])])
+    return [nonlinear[k] for k in unsafe_outputs(f, (0, 1, 2))]
 
 
 def _all_finite(a: np.ndarray) -> bool:

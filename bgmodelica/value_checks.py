@@ -98,24 +98,32 @@ def _value_bounds(dae: Any) -> tuple[np.ndarray, np.ndarray]:
 def _check_starts(dae: Any, flat: Any) -> None:
     """Fixed start values inside their bounds, all start values finite."""
     wanted = {dae.names[k] for k, _ in dae.fixed}
-    decls = {}
+    decls: dict[str, Any] = {}
     if flat is not None and wanted:
-        lookup = getattr(flat.variables, "lookup", None)     # (a large model's, by index)
-        decls = lookup(wanted) if lookup is not None else \
-            {v.name: v for v in flat.variables if v.name in wanted}
+        by_name = getattr(flat.variables, "declarations", None)   # (a large model's)
+        decls = by_name(wanted) if by_name is not None else \
+            {v.name: v.decl for v in flat.variables if v.name in wanted}
     for k, value in dae.fixed:
         name = dae.names[k]
-        v = decls.get(name)
-        decl = v.decl if v is not None else None
+        decl = decls.get(name)
         value = float(value)
         if math.isfinite(value) and not _has_bounds(decl):
             continue
+        v = _variable(flat, name) if decl is not None else None
         _check_one("start value of", name, value, decl, _declared(v) if v is not None else "")
     for names, starts in ((dae.state_names, dae.x_start), (dae.algebraic_names, dae.z_start)):
         starts = np.asarray(starts, dtype=float).ravel()
         for k in np.flatnonzero(~np.isfinite(starts[:len(names)])).tolist()[:1]:
             raise ParameterError(f"start value of {names[k]} is {starts[k]}: it must be a "
                                  "finite number")
+
+
+def _variable(flat: Any, name: str) -> Any:
+    """The flat variable ``name`` (for where it was declared)."""
+    lookup = getattr(flat.variables, "lookup", None)
+    if lookup is not None:
+        return lookup({name}).get(name)
+    return next((v for v in flat.variables if v.name == name), None)
 
 
 def _declared(v: Any, sep: str = " (") -> str:

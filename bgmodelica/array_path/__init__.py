@@ -1,7 +1,8 @@
 """The array path: large models compiled without a Python object per scalar.
 
 Two kinds of model take it: a leaf model of array equations (:mod:`.collect`), and a model
-of many leaf components joined by ``connect`` (:mod:`.components`, its connection sets as
+of components, flat or hierarchical, joined by ``connect`` (:mod:`.components`, its
+identical leaves written once across their parents, its connection sets as
 linear rows: :mod:`.connections`). ``compile`` sends a model here first
 (:func:`compile_arrays`). A model it takes is lowered to MX blocks (:mod:`.lowering`), its
 aliases eliminated (:mod:`.aliases`), ordered on its integer incidence
@@ -237,11 +238,22 @@ class _Variables(Sequence):
         """Name -> declared unit, without an item per variable."""
         return dict(zip(self.names, map(_UNIT, map(_DECL, self.symbols)), strict=True))
 
-    def lookup(self, names: set[str]) -> dict[str, Declared]:
-        """The variables of these names (name -> item; names not found are left out)."""
+    def declarations(self, names: set[str]) -> dict[str, Any]:
+        """The declarations of these names (name -> declaration; names not found are left
+        out), without an item per variable."""
+        index = self._index_of()
+        symbols = self.symbols
+        return {name: symbols[index[name]].decl for name in names if name in index}
+
+    def _index_of(self) -> dict[str, int]:
         index = self.__dict__.get("_index")
         if index is None:
             index = self._index = dict(zip(self.names, range(len(self.names)), strict=True))
+        return index
+
+    def lookup(self, names: set[str]) -> dict[str, Declared]:
+        """The variables of these names (name -> item; names not found are left out)."""
+        index = self._index_of()
         return {name: self[index[name]] for name in names if name in index}
 
 

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from ..core.component import Connector
 from ..core.flatten_vectorized import GROUP_FROM, _same_keys
 from ..core.variables import Flow, Output, Parameter, Potential, Variable
 from .collect import SOFT_STATE_SELECT, Traits
@@ -27,17 +28,19 @@ _NUMBERS = (int, float, np.integer, np.floating)
 
 
 class Columns:
-    """The columns of a model of leaf components, in the scalar pipeline's order: the tree
-    (each component, then its connectors), each variable followed by its derivative; the
-    parameters after them in the same order. Worked out per class of component and per
-    declaration: ``pos`` (``id(symbol)`` -> column), ``order`` and ``names`` (variables),
-    ``params``, ``param_names`` and ``param_owners``; the connectors numbered in tree order
-    (``connector``: ``id`` -> number, ``paths``, ``kinds``: their variables' names and
-    whether each is a flow, ``columns``: their variables' columns)."""
+    """The columns of a model of components, in the scalar pipeline's order: the tree
+    (each component, then its connectors, then its subcomponents), each variable followed
+    by its derivative; the parameters after them in the same order. Worked out per class
+    of component and per declaration: ``pos`` (``id(symbol)`` -> column), ``order`` and
+    ``names`` (variables), ``params``, ``param_names`` and ``param_owners``; the
+    connectors numbered in tree order (``connector``: ``id`` -> number, ``paths``,
+    ``kinds``: their variables' names and whether each is a flow, ``columns``: their
+    variables' columns)."""
 
     def __init__(self, children: dict[str, Any], checked: list[list[Any]]) -> None:
-        """``children`` by path in tree order (the top level first, as ``""``, when it
-        declares variables or parameters); ``checked``: groups of components known to share
+        """``children``: the components by path in tree order (the top level first, as
+        ``""``, when it declares variables or parameters; a component's connectors come
+        before its subcomponents); ``checked``: groups of components known to share
         their declarations (written once)."""
         self.refused: str | None = None
         paths = list(children)
@@ -202,9 +205,11 @@ class _Layout(list):
 
 
 def _layout_key(child: Any) -> tuple:
-    """A component's declarations and connectors (with theirs)."""
+    """A component's declarations and connectors (with theirs); its subcomponents are
+    elements of their own."""
     return (tuple(child._symbols), tuple((name, type(sub), tuple(sub._symbols))
-                                         for name, sub in child._children.items()))
+                                         for name, sub in child._children.items()
+                                         if isinstance(sub, Connector)))
 
 
 class _Slot:

@@ -309,6 +309,8 @@ def connect(a: Any, b: Any) -> Any:
     connectors or signals are joined elementwise (a list of :class:`Connection`)."""
     if isinstance(a, (ElementArray, ArrayExpr)) or isinstance(b, (ElementArray, ArrayExpr)):
         return connect_arrays(_as_array(a), _as_array(b), connect)
+    if getattr(type(a), "_group_view", False) or getattr(type(b), "_group_view", False):
+        return Connection(a, b)           # views of many connectors: checked by their reader
     check_connectable(a, b)
     return Connection(a, b)
 

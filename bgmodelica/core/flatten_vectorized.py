@@ -28,7 +28,7 @@ import numpy as np
 
 from .array_marks import mark_leaves
 from .arrays import ArrayEquation, ArrayExpr
-from .component import Component, Connector, _own_methods
+from .component import Component, Connection, Connector, _own_methods, check_connectable
 from .expr import Leaf
 
 #: plain attribute values a view hands out when every element has the same one
@@ -45,11 +45,15 @@ _SYM, _DECL, _UNIT = attrgetter("sym"), attrgetter("decl"), attrgetter("unit")
 class _View:
     """Elements of one class seen as one: attributes are arrays of the elements' ones."""
 
-    __slots__ = ("_items", "_seen")
+    __slots__ = ("_items", "_seen", "_deep")
+    #: ``connect`` of two views is one :class:`~.component.Connection` of them
+    _group_view = True
 
-    def __init__(self, items: list[Any]) -> None:
+    def __init__(self, items: list[Any], deep: bool = False) -> None:
+        """``deep``: subcomponents are views too (not only connectors)."""
         object.__setattr__(self, "_items", items)
         object.__setattr__(self, "_seen", {})     # name -> array or view, made once
+        object.__setattr__(self, "_deep", deep)
 
     def __getattr__(self, name: str) -> Any:
         seen = self._seen.get(name)
@@ -84,8 +88,8 @@ class _View:
                         and len(set(map(_UNIT, decls))) == 1)
             found = self._seen[name] = ArrayExpr(arr)
             return found
-        if isinstance(first, Connector):
-            found = self._seen[name] = _View(values)
+        if isinstance(first, Connector) or (self._deep and isinstance(first, Component)):
+            found = self._seen[name] = _View(values, self._deep)
             return found
         if isinstance(first, _PLAIN) and all(type(v) is type(first) and v == first
                                              for v in values):
@@ -114,26 +118,57 @@ def component_groups(elem: Component) -> list[tuple[list[str], list[Any]]]:
     rest, the components of one class when there are :data:`GROUP_FROM` or more (a
     component per section of a ladder). Each group as ``(child names, children)``."""
     children = elem._children
+    out = _array_groups(elem, "")
+    if len(children) >= GROUP_FROM:
+        taken = {id(c) for _, items in out for c in items}
+        out += _class_groups((key, child) for key, child in children.items()
+                             if isinstance(child, Component) and id(child) not in taken)
+    return out
+
+
+def tree_groups(components: dict[str, Any], parents: list[tuple[str, Component]],
+                ) -> list[tuple[list[str], list[Any]]]:
+    """:func:`component_groups` across a whole tree: the arrays of components of every
+    parent (``parents``: the components holding components, by path, in tree order), then,
+    among the other components without subcomponents (``components``: all but the top
+    level, by path, in tree order), those of one class when there are :data:`GROUP_FROM` or
+    more, wherever they sit (the resistor of each section of a ladder of sections). Each
+    group as ``(paths, components)``; for a flat model, ``component_groups(top)``."""
+    out: list[tuple[list[str], list[Any]]] = []
+    for path, parent in parents:
+        out += _array_groups(parent, f"{path}." if path else "")
+    taken = {id(c) for _, items in out for c in items}
+    out += _class_groups((path, child) for path, child in components.items()
+                         if id(child) not in taken and isinstance(child, Component)
+                         and not any(isinstance(c, Component)
+                                     for c in child._children.values()))
+    return out
+
+
+def _array_groups(elem: Component, prefix: str) -> list[tuple[list[str], list[Any]]]:
+    """The arrays of components of ``elem`` (two elements or more), names after
+    ``prefix``."""
     arrays: dict[str, tuple[list[str], list[Any]]] = {}
     if "_arrays" in elem.__dict__:
-        for key, child in children.items():
+        for key, child in elem._children.items():
             if key[-1] == "]" and isinstance(child, Component):
                 base, _, index = key[:-1].partition("[")
                 if index.isdigit():
                     names, items = arrays.setdefault(base, ([], []))
-                    names.append(key)
+                    names.append(prefix + key)
                     items.append(child)
-    out = [group for group in arrays.values() if len(group[1]) > 1]
-    if len(children) >= GROUP_FROM:
-        taken = {id(c) for _, items in out for c in items}
-        by_class: dict[type, tuple[list[str], list[Any]]] = {}
-        for key, child in children.items():
-            if isinstance(child, Component) and id(child) not in taken:
-                names, items = by_class.setdefault(type(child), ([], []))
-                names.append(key)
-                items.append(child)
-        out += [group for group in by_class.values() if len(group[1]) >= GROUP_FROM]
-    return out
+    return [group for group in arrays.values() if len(group[1]) > 1]
+
+
+def _class_groups(members: Any) -> list[tuple[list[str], list[Any]]]:
+    """``(name, component)`` pairs grouped by class, the groups of :data:`GROUP_FROM` or
+    more in the order of their first member."""
+    by_class: dict[type, tuple[list[str], list[Any]]] = {}
+    for key, child in members:
+        names, items = by_class.setdefault(type(child), ([], []))
+        names.append(key)
+        items.append(child)
+    return [group for group in by_class.values() if len(group[1]) >= GROUP_FROM]
 
 
 def array_equations(items: list[Any],
@@ -171,6 +206,33 @@ def array_equations(items: list[Any],
             else:
                 arrays.update(((name, key), found) for key, found in seen._seen.items()
                               if isinstance(found, ArrayExpr))
+    return out
+
+
+def group_connections(items: list[Any]) -> list[tuple[Any, Any]] | None:
+    """The ``connect`` statements of components ``items`` (of one class, holding exactly
+    its declarations, subcomponents and connectors), written once for all of them: pairs
+    of connector views (their ``_items`` are the ends, member by member), or None when
+    their equations are not only connections the view can answer."""
+    first = items[0]
+    if len(items) < 2 or any(map(_EQUATIONS, items)) or not _as_declared(items):
+        return None
+    view = _View(items, deep=True)
+    out: list[tuple[Any, Any]] = []
+    try:
+        for own in _own_methods(type(first), "equations"):
+            result = own(view)
+            if result is None:
+                continue
+            for eq in result:
+                if type(eq) is not Connection or type(eq.a) is not _View \
+                        or type(eq.b) is not _View or not isinstance(eq.a, Connector) \
+                        or not isinstance(eq.b, Connector):
+                    return None
+                check_connectable(eq.a._items[0], eq.b._items[0])
+                out.append((eq.a, eq.b))
+    except Exception:  # noqa: BLE001 -- anything the view cannot answer: one by one instead
+        return None
     return out
 
 

@@ -13,11 +13,13 @@ from library.electrical import (
     ConstantVoltage,
     Ground,
     Inductor,
+    Pin,
     Resistor,
     SineVoltage,
 )
 
-__all__ = ["RC", "SeriesRLC", "RCLadder", "RCLadderArrays", "RCLadderVector"]
+__all__ = ["RC", "SeriesRLC", "RCLadder", "RCLadderArrays", "RCLadderSections", "RCLadderVector",
+           "Section"]
 
 
 class RC(Component):
@@ -88,6 +90,51 @@ class RCLadder(Component):
             self.connect(resistor.n, capacitor.p)
             self.connect(capacitor.n, self.ground.p)
             node = resistor.n
+
+
+class Section(Component):
+    """One section of an RC ladder: a resistor from ``p`` to ``n`` and a capacitor from ``n``
+    to ``ground``.
+
+    Connectors: ``p``, ``n``, ``ground`` (Pin). Subcomponents: ``R`` (Resistor, R = 1 Ohm),
+    ``C`` (Capacitor, C = 1 F; its voltage ``C.v`` is the state). Set them by modifiers:
+    ``Section(**{"R.R": 0.5, "C.C": 0.25, "C.v": 2.0})``.
+    """
+
+    p = Pin()
+    n = Pin()
+    ground = Pin()
+    R = Resistor(R=1.0)
+    C = Capacitor(C=1.0)
+
+    def equations(self):
+        yield connect(self.p, self.R.p)
+        yield connect(self.R.n, self.C.p)
+        yield connect(self.R.n, self.n)
+        yield connect(self.C.n, self.ground)
+
+
+class RCLadderSections(Component):
+    """:class:`RCLadder` built from a :class:`Section` per rung: ``section1..section{n}``,
+    section ``k`` with ``R.R = 1/k`` Ohm, ``C.C = 1/k^2`` F and ``C.v(0) = k`` V, chained
+    ``p`` to ``n`` from the sine source, every ``ground`` pin to the ground. Same equations
+    and results as :class:`RCLadder` (its ``Ck.v`` is ``section{k}.C.v`` here)."""
+
+    def __init__(self, n: int = 10, **modifiers):
+        super().__init__(**modifiers)
+        if n < 1:
+            raise ValueError("RCLadderSections needs n >= 1 sections")
+        self.n_sections = n
+        self.source = SineVoltage(V=1.0, f=10.0)
+        self.ground = Ground()
+        self.connect(self.source.n, self.ground.p)
+        node = self.source.p
+        for k in range(1, n + 1):
+            section = self.add(f"section{k}", Section(**{"R.R": 1.0 / k, "C.C": 1.0 / k**2,
+                                                         "C.v": float(k)}))
+            self.connect(node, section.p)
+            self.connect(section.ground, self.ground.p)
+            node = section.n
 
 
 def _ladder_values(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

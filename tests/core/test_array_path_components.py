@@ -380,19 +380,6 @@ def test_parallel_rc_branches_charge_as_the_analytic_solution():
 
 # -- 3. what goes the scalar way, and why ----------------------------------------------------------
 
-class Nested(Component):
-    """An :class:`RC` circuit (which has subcomponents) beside a resistor across a
-    ground."""
-
-    def __init__(self, **modifiers):
-        super().__init__(**modifiers)
-        self.rc = RC()
-        self.extra = Resistor()
-        self.ground = Ground()
-        self.connect(self.extra.p, self.ground.p)
-        self.connect(self.extra.n, self.ground.p)
-
-
 class OwnVariables(RCLadder):
     """:class:`RCLadder` with a variable of the top level: ``total = C1.v + C2.v``."""
 
@@ -478,11 +465,10 @@ class SignalDriven(Component):
 
 
 @pytest.mark.parametrize(("make", "reason"), [
-    (Nested, "a subcomponent has subcomponents"),
     (WithInitialEquations, "a subcomponent has initial equations"),
     (SignalDriven, "the top level connects signals"),
     (lambda: AlwaysMassChain(3), "a variable has a state selection"),
-], ids=["nested", "initial-equations", "signal-connection",
+], ids=["initial-equations", "signal-connection",
         "state-selection"])
 def test_models_going_the_scalar_way_say_why_and_compile(make, reason):
     found = why_not(make(), minimum=0)
@@ -495,15 +481,15 @@ def test_models_going_the_scalar_way_say_why_and_compile(make, reason):
     assert compiled.dae.state_names == slow.dae.state_names
 
 
-def test_a_large_nested_model_goes_the_scalar_way_and_simulates():
+def test_a_large_nested_model_takes_the_array_path_and_simulates():
     class BigNested(RCLadder):
         def __init__(self):
             super().__init__(400)
             self.rc = RC()
 
-    assert why_not(BigNested()) == "a subcomponent has subcomponents"
+    assert why_not(BigNested()) is None
     compiled = bg.compile(BigNested())
-    assert not isinstance(compiled, ArrayCompiledModel)
+    assert isinstance(compiled, ArrayCompiledModel)
     res = bg.simulate(compiled, stop_time=1.0, interval=0.5, **TIGHT, outputs=["rc.capacitor.v"])
     assert res["rc.capacitor.v"][-1] == pytest.approx(10.0 * (1 - np.exp(-1.0)), rel=1e-7)
 

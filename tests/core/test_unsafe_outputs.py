@@ -40,3 +40,17 @@ def test_all_finite_is_exact_when_the_sum_overflows_or_cancels():
     a = np.ones(6)
     a[0], a[1] = np.inf, -np.inf                              # the sum is nan, not inf
     assert not _all_finite(a)
+
+
+def test_the_result_check_analyses_only_what_is_nonlinear_in_what_varies():
+    from types import SimpleNamespace
+
+    from bgmodelica.simulate import _unsafe
+
+    t, x, z, p = ca.SX.sym("t"), ca.SX.sym("x", 4), ca.SX.sym("z", 0), ca.SX.sym("p")
+    observed = ca.vertcat(x[0] / x[1], x[0] / p, ca.sqrt(x[2] * p), ca.log(p) * x[3],
+                          x[0] ** x[1], ca.sin(t) / 2, x[0] * p + 3, ca.exp(1 / x[2]) - x[3],
+                          x[1] / (t - 1), x[0] + x[1])
+    dae = SimpleNamespace(t=t, x=x, z=z, p=p, observed=observed)
+    assert _unsafe(dae, range(10)) == [0, 2, 4, 7, 8]
+    assert _unsafe(dae, [1, 3, 5, 6, 9]) == []
