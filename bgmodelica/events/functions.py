@@ -35,6 +35,9 @@ class HybridFunctions:
     pre_discrete: np.ndarray    # bool: the pre source is a discrete-valued variable
     discrete_obs: np.ndarray    # obs indices of equation-defined discrete variables
     alg_solver: ca.Function | None    # z from (t, x, p), DAE models only
+    #: bool per branch: its condition mentions initial() (it fires at initialization even
+    #: when the rest of the condition is already true, as in ``when {c, initial()}``)
+    initial_branch: np.ndarray | None = None
 
     @property
     def relations(self):
@@ -112,6 +115,9 @@ def build(dae: CasadiDAE) -> HybridFunctions:
         branch_of, assign_of, reinit_of,
         np.array([nb + slot for slot, _ in hyb.pre], dtype=int),
         np.array(pre_disc, dtype=bool), np.array(discrete_obs, dtype=int), alg_solver)
+    if hyb.initial >= 0 and conds:
+        init_sym = p[nb + hyb.initial]
+        out.initial_branch = np.array([bool(ca.depends_on(c, init_sym)) for c in conds])
     dae.cache["hybrid"] = out
     return out
 

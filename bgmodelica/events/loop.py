@@ -337,6 +337,8 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         # conditions true at the start do not fire; initial() and samples at t0 do
         out = self._step(t0, x, z)
         self.cond_pre = np.asarray(out[2], dtype=float).copy()
+        if fn.initial_branch is not None:
+            self.cond_pre[fn.initial_branch] = 0.0
         self._set_pre_from(out)
         samples = [slot for start, interval, slot in self.samples
                    if is_sample_instant(start, interval, t0)]

@@ -58,3 +58,17 @@ def test_while_on_a_time_varying_condition_is_refused():
     with pytest.raises(ModelicaError, match="while-loop condition depends on time-varying"):
         bg.simulate(load_modelica_text(_model("  Real x = f(time);", fn), "P.M"),
                     stop_time=0.1)
+
+
+def test_return_under_a_time_varying_condition():
+    fn = ("function firstTrue\n  input Boolean b[:];\n  output Integer index;\nalgorithm\n"
+          "  index := 0;\n  for i in 1:size(b, 1) loop\n    if b[i] then\n      index := i;\n"
+          "      return;\n    end if;\n  end for;\nend firstTrue;\n")
+    model = load_modelica_text(
+        _model("  Integer k;\nequation\n  k = firstTrue({time > 0.7, time > 0.3, time > 0.5});",
+               fn), "P.M")
+    r = bg.simulate(model, stop_time=1.0)
+    t, k = r.time, r["k"]
+    inner = np.r_[True, np.diff(t) > 0] & np.r_[np.diff(t) > 0, True]   # not at events
+    expected = np.where(t > 0.7, 1, np.where(t > 0.3, 2, 0))
+    np.testing.assert_array_equal(k[inner], expected[inner])

@@ -197,10 +197,13 @@ def _initial(comp: A.Component, lex: S.ClassScope, local: dict, info: Any) -> An
 
 
 class _State:
-    __slots__ = ("steps", "whens", "leaves")
+    __slots__ = ("steps", "whens", "leaves", "guard")
 
     def __init__(self) -> None:
         self.steps = 0
+        #: True, or the time-varying condition under which no ``return`` has happened yet
+        #: (assignments then keep the returned value where it is false)
+        self.guard: Any = True
         self.whens: list | None = None        # collects when-statements in a model
         self.leaves: dict = {}                # the model variables a model's algorithm assigns
 
@@ -232,7 +235,7 @@ def _run(stmts: tuple, ctx: Ctx, state: _State) -> None:
                        "(an endless loop?)")
         t = type(st)
         if t is A.Assign:
-            _assign(st, ctx)
+            _assign(st, ctx, state)
         elif t is A.StmtIf:
             _if(st, ctx, state)
         elif t is A.StmtFor:
@@ -280,19 +283,29 @@ def _if(st: A.StmtIf, ctx: Ctx, state: _State) -> None:
         # a symbolic condition: both sides, merged
         rest = A.StmtIf(st.branches[k + 1:], st.otherwise, st.pos) if st.branches[k + 1:] \
             else None
-        then_vals = dict(ctx.loops)
-        else_vals = dict(ctx.loops)
-        then_vals = {n: copy.copy(v) for n, v in then_vals.items()}
-        else_vals = {n: copy.copy(v) for n, v in else_vals.items()}
+        then_vals = {n: copy.copy(v) for n, v in ctx.loops.items()}
+        else_vals = {n: copy.copy(v) for n, v in ctx.loops.items()}
+        g0 = state.guard
+        then_done = else_done = False
         try:
             _run(body, Ctx(ctx.env, ctx.lex, then_vals, False), state)
+        except _Return:
+            then_done = True
+        except _Break:
+            raise fail(ctx.lex, st, "break under a time-varying condition (not supported)") \
+                from None
+        g_then, state.guard = state.guard, g0
+        try:
             if rest is not None:
                 _if(rest, Ctx(ctx.env, ctx.lex, else_vals, False), state)
             else:
                 _run(st.otherwise, Ctx(ctx.env, ctx.lex, else_vals, False), state)
-        except (_Return, _Break):
-            raise fail(ctx.lex, st, "return/break under a time-varying condition (not "
-                       "supported)") from None
+        except _Return:
+            else_done = True
+        except _Break:
+            raise fail(ctx.lex, st, "break under a time-varying condition (not supported)") \
+                from None
+        g_else = state.guard
         for name in set(then_vals) | set(else_vals):
             a, b = then_vals.get(name), else_vals.get(name)
             if a is b:
@@ -302,8 +315,21 @@ def _if(st: A.StmtIf, ctx: Ctx, state: _State) -> None:
                            "on a time-varying condition")
             else:
                 ctx.loops[name] = _merge(c, a, b, ctx, st)
+        if then_done and else_done:
+            raise _Return()
+        state.guard = _select(c, False if then_done else g_then, False if else_done else g_else,
+                              ctx, st)
         return
     _run(st.otherwise, ctx, state)
+
+
+def _select(c: Any, a: Any, b: Any, ctx: Ctx, node: Any) -> Any:
+    """``if c then a else b`` for guards (True, False or a symbolic condition)."""
+    if a is True and b is True:
+        return True
+    a = 1.0 if a is True else 0.0 if a is False else a
+    b = 1.0 if b is True else 0.0 if b is False else b
+    return _if_else(c, a, b, ctx, node) > 0.5
 
 
 def _merge(c: Any, a: Any, b: Any, ctx: Ctx, node: Any) -> Any:
@@ -346,7 +372,7 @@ def _for(st: A.StmtFor, ctx: Ctx, state: _State) -> None:
         ctx.loops.update(saved)
 
 
-def _assign(st: A.Assign, ctx: Ctx) -> None:
+def _assign(st: A.Assign, ctx: Ctx, state: _State | None = None) -> None:
     from .evaluate import evaluate
 
     target = st.target
@@ -359,7 +385,12 @@ def _assign(st: A.Assign, ctx: Ctx) -> None:
             if item is not None:
                 _store(item, v, ctx, st)
         return
-    _store(target, evaluate(st.value, ctx), ctx, st)
+    value = evaluate(st.value, ctx)
+    if state is not None and state.guard is not True and isinstance(target, A.Ref) \
+            and len(target.parts) == 1 and not target.parts[0][1] \
+            and ctx.loops.get(target.parts[0][0]) is not None:
+        value = _merge(state.guard, value, ctx.loops[target.parts[0][0]], ctx, st)
+    _store(target, value, ctx, st)
 
 
 def call_outputs(call: A.Call, ctx: Ctx) -> tuple:

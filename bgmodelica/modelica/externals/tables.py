@@ -213,8 +213,15 @@ class CombiTimeTable(_Table):
             g = (self.shift_time + (ev[None, :] + ks[:, None] * period)).ravel()
         return np.unique(g[(g >= a) & (g <= b)])
 
-    def next_event(self, t: float) -> float:
-        """First event instant after ``t`` [s], or :data:`NO_EVENT`."""
+    #: at most this many event instants in the closed form of a symbolic ``next_event``
+    MAX_SYMBOLIC_EVENTS = 2000
+
+    def next_event(self, t: Any) -> Any:
+        """First event instant after ``t`` [s], or :data:`NO_EVENT`; for a symbolic ``t`` a
+        piecewise-constant expression of it (a periodic table: its first
+        :data:`MAX_SYMBOLIC_EVENTS` events)."""
+        if is_symbolic(t):
+            return self._next_event_symbolic(t)
         t = float(t)
         if t < self.start_time - _tol(self.start_time):
             return self.start_time
@@ -227,6 +234,20 @@ class CombiTimeTable(_Table):
             g = self.shift_time + self.events
         g = g[g > lo]
         return float(g.min()) if g.size else NO_EVENT
+
+    def _next_event_symbolic(self, t: Any) -> Any:
+        start = self.start_time
+        if self.extrapolation == PERIODIC and self.events.size:
+            period = self.u_max - self.u_min
+            per = max(1, len(self.events))
+            horizon = start + period * max(1, self.MAX_SYMBOLIC_EVENTS // per)
+        else:
+            horizon = max(start, self.shift_time + self.u_max) + 1.0
+        points = self.breakpoints(start, horizon)[: self.MAX_SYMBOLIC_EVENTS]
+        out: Any = NO_EVENT
+        for b in reversed(points):
+            out = if_else(t < b - _tol(b), b, out)
+        return _no_event(out)
 
     def breakpoints(self, t0: float, t1: float) -> list[float]:
         """Sorted event instants in [t0, t1] [s]: ``startTime`` and the table's events."""
