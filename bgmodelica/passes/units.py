@@ -120,6 +120,14 @@ _COMPARE = frozenset(("<", "<=", "!=", "=="))
 _LOGIC = frozenset(("and", "or", "not"))
 
 
+def _is_zero(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and x == 0
+
+
+def _is_if_else(x: Any) -> bool:
+    return isinstance(x, Op) and x.op == "if_else"
+
+
 # -- the checker ------------------------------------------------------------------------------
 
 
@@ -195,8 +203,20 @@ class _Checker:
                         lambda e=first: self.equation(e), len(eq))
 
     def equation(self, eq: Equation) -> Any:
+        if _is_zero(eq.rhs) and _is_if_else(eq.lhs):
+            return self._residual(eq.lhs)
         lhs, rhs = self.infer(eq.lhs), self.infer(eq.rhs)
         return combine(lhs, rhs, "left side is {0}, right side is {1}")
+
+    def _residual(self, e: Any) -> Any:
+        """``0 = if c then r1 else r2`` (an if-equation whose branches are different
+        equations): each branch residual is checked on its own."""
+        if _is_if_else(e):
+            self.infer(e.args[0])
+            self._residual(e.args[1])
+            self._residual(e.args[2])
+            return None
+        return self.infer(e)
 
     # -- hybrid parts
     def _hybrid(self, draft: Any) -> None:

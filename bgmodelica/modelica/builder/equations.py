@@ -282,6 +282,17 @@ def _eval_if_equation(eq: A.EqIf, ctx: Ctx, out: list, initial: bool) -> None:
         eqs: list = []
         for sub in body:
             _eval_equation(sub, ctx, eqs, initial)
+        nested = [e for e in eqs if isinstance(e, H.IfEquation)]
+        if len(nested) == 1:
+            # one nested if-equation: its branches become branches of this one
+            inner = nested[0]
+            plain = [e for e in eqs if e is not inner]
+            for ci, eqs_i in inner.branches:
+                branches.append((ci if c is True else c & ci, plain + list(eqs_i)))
+            eqs = plain + list(inner.otherwise)
+        else:
+            eqs = [x for e in eqs for x in (_residuals(e, ctx, eq)
+                                             if isinstance(e, H.IfEquation) else [e])]
         for e in eqs:
             if not isinstance(e, Equation):
                 raise fail(ctx.lex, eq, "an if-equation with a condition that changes during "
@@ -293,6 +304,30 @@ def _eval_if_equation(eq: A.EqIf, ctx: Ctx, out: list, initial: bool) -> None:
         out.append(H.if_equation(first_c, first, otherwise, *branches[1:]))
     except ModelError as err:
         raise fail(ctx.lex, eq, str(err)) from None
+
+
+def _residuals(ifeq: Any, ctx: Ctx, node: Any) -> list:
+    """A nested if-equation as equations ``0 = if c1 then r1 elseif ... else rn`` of the
+    residuals of its branches (each branch must hold the same number of equations)."""
+    from .arith import _if_else
+
+    branches = list(ifeq.branches) + [(True, ifeq.otherwise)]
+    sizes = {len(b) for _, b in branches}
+    if len(sizes) != 1:
+        raise fail(ctx.lex, node, "the branches of an if-equation with a condition that "
+                   "changes during the simulation must hold the same number of equations")
+    out = []
+    for k in range(sizes.pop()):
+        res: Any = None
+        for c, eqs in reversed(branches):
+            e = eqs[k]
+            if not isinstance(e, Equation):
+                raise fail(ctx.lex, node, "an if-equation with a condition that changes "
+                           "during the simulation may hold only equations 'a = b'")
+            r = e.lhs - e.rhs
+            res = r if res is None else _if_else(c, r, res, ctx, node)
+        out.append(Equation(res, 0.0))
+    return out
 
 
 def _eval_when(eq: A.EqWhen, ctx: Ctx) -> Any:
