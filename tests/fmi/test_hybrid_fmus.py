@@ -288,13 +288,6 @@ def test_tables_counter_input_relation_and_terminal(build):
     shutil.rmtree(unzipped, ignore_errors=True)
 
 
-def test_unsupported_events_are_refused():
-    from library.examples.hybrid import PendulumWall
-
-    with pytest.raises(FmuSpecError, match=r"reinit\(vy, \.\.\.\) restarts a variable"):
-        export_model(PendulumWall(), "/nonexistent", static_states=True)
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("fmu_type", ["me", "cs"])
 @pytest.mark.parametrize("version", [2, 3])

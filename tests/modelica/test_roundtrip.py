@@ -46,8 +46,12 @@ def test_every_example_is_covered():
 
 @pytest.mark.parametrize("cls", EXAMPLES)
 def test_round_trip(cls, tmp_path):
+    from bgmodelica.core.component import Connector
+
     model = cls()
     name = cls.__name__
+    if any(isinstance(c, Connector) for c in model._children.values()):
+        pytest.skip(f"{name} is a part with connectors, not a standalone model")
     stop = STOP.get(name, 1.0)
     path = tmp_path / f"{name}.mo"
     text = export_modelica(model, path, experiment={"StopTime": stop})

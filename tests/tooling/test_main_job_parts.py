@@ -25,6 +25,7 @@ def test_build_cache_reuses_the_binary(tmp_path, monkeypatch):
         return real(*args, **kwargs)
 
     monkeypatch.setattr(build, "compile_shared_library", counting)
+    monkeypatch.setenv("SOURCE_DATE_EPOCH", "1700000000")     # the same generation date
     job.use_build_cache(str(tmp_path / "cache"))
     first = export_model(DCMotorIO(), tmp_path / "a", fmu_type="cs")
     second = export_model(DCMotorIO(), tmp_path / "b", fmu_type="cs")

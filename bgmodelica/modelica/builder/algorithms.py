@@ -552,7 +552,7 @@ def section_equations(stmts: A.Statements, ctx: Ctx, out: list, initial: bool) -
     ``when``-statement a when-equation of the variables its branches assign (starting from
     their ``pre`` values). In an initial algorithm the assignments become initial
     equations."""
-    from .equations import _equation
+    from .equations import _discrete_start, _equation, _parameter_value
     from .evaluate import evaluate
 
     names = _targets(stmts)
@@ -576,6 +576,9 @@ def section_equations(stmts: A.Statements, ctx: Ctx, out: list, initial: bool) -
             continue
         if local.get(n) is None:
             raise fail(ctx.lex, stmts, f"{n} is not assigned on every path of the algorithm")
+        if initial and (_discrete_start(leaves[n], local[n], ctx, stmts)
+                        or _parameter_value(leaves[n], local[n], ctx, stmts)):
+            continue
         _equation(leaves[n], local[n], ctx, stmts, out)
     for branches in state.whens:
         out.append(_when_of(branches, leaves, ctx, stmts))

@@ -109,6 +109,8 @@ def numeric_value(v: Any, lex: Any = None, node: Any = None, _memo: dict | None 
     if isinstance(v, Leaf):
         sym = v.sym
         if sym is TIME:
+            if _memo is not None and "time" in _memo:
+                return _memo["time"]
             raise NotConstant("time")
         decl = getattr(sym, "decl", None)
         if decl is None or decl.kind != KIND_PARAMETER:

@@ -94,6 +94,11 @@ def _eval_equation(eq: Any, ctx: Ctx, out: list, initial: bool) -> None:
         raise fail(ctx.lex, eq, str(err)) from None
 
 
+#: the time at which initial equations of discrete variables are evaluated when the model is
+#: built [s]
+INITIAL_TIME = 0.0
+
+
 def _discrete_start(a: Any, b: Any, ctx: Ctx, node: Any) -> bool:
     """An initial equation ``d = value`` of a discrete variable whose value is known when
     the model is built sets its start value (its value before the first event)."""
@@ -108,7 +113,8 @@ def _discrete_start(a: Any, b: Any, ctx: Ctx, node: Any) -> bool:
     if decl is None or decl.kind != KIND_DISCRETE:
         return False
     try:
-        value = numeric_value(b, ctx.lex, node)
+        # at initialization time is the start time, 0 in the examples of the libraries
+        value = numeric_value(b, ctx.lex, node, {"time": INITIAL_TIME})
     except NotConstant:
         return False
     if isinstance(value, S.EnumValue):

@@ -77,6 +77,9 @@ def _ev_ref(node: A.Ref, ctx: Ctx) -> Any:
         if not _is_value(found):
             raise NotConstant(name)
         val = _lexical_value(found, ctx, node)
+    elif env is not None and name in env.view.elements and len(parts) > 1 \
+            and _unbuilt_child(env, name):
+        return _child_parameter(env, name, parts[1:], ctx, node)
     elif env is not None and name in env.view.elements:
         val = _env_member(env, name, ctx, node)
     elif env is not None and env.inst is not None and (
@@ -115,6 +118,32 @@ def _ev_ref(node: A.Ref, ctx: Ctx) -> Any:
         if subs:
             val = _subscript(val, subs, ctx, node)
     return val
+
+
+def _unbuilt_child(env: Env, name: str) -> bool:
+    """Whether ``name`` is a subcomponent of ``env`` not built yet (a sibling's modifier
+    reads its parameters: ``startTime = -vIn.rising``)."""
+    info = env.view.elements[name]
+    if _category(info, type_ref(info)) != "child" or info.comp.dims:
+        return False
+    inst = env.inst
+    return inst is None or name not in inst._children
+
+
+def _child_parameter(env: Env, name: str, rest: tuple, ctx: Ctx, node: Any) -> Any:
+    """A parameter of a subcomponent not built yet: its modifier here, else its class's
+    value."""
+    (pname, subs), more = rest[0], rest[1:]
+    if more or subs:
+        raise NotConstant(f"{name}.{pname}")
+    m = env.emod(name)
+    sub = m.sub.get(pname) if m is not None else None
+    if sub is not None and sub.has_binding:
+        return sub.value(True)
+    tref = type_ref(env.view.elements[name])
+    if tref.kind != "class" or tref.scope is None:
+        raise NotConstant(f"{name}.{pname}")
+    return static_env(tref.scope).numeric(pname)
 
 
 def _map_member(val: list, name: str, ctx: Ctx, node: Any) -> list:
