@@ -42,7 +42,6 @@ from bgmodelica import (
     when,
 )
 from bgmodelica.fmi.from_model import export_model
-from bgmodelica.fmi.spec import FmuSpecError
 
 HERE = Path(__file__).resolve().parent
 TIGHT = {"rtol": 1e-10, "atol": 1e-12}
