@@ -107,7 +107,16 @@ def combine(a: Any, b: Any, message: str) -> Any:
         return a
     if a.unit.same(b.unit):
         return a
+    if _affine(a.unit, b.unit):
+        return a
     raise Mismatch(message.format(a, b))
+
+
+def _affine(u: Any, v: Any) -> bool:
+    """Units that differ by their zero only (degC and K): an equation between them writes
+    the conversion out (``T_degC = T - 273.15``), as the MSL's conversion functions do."""
+    return u.dims == v.dims and u.offset != v.offset \
+        and abs(u.factor - v.factor) <= 1e-9 * abs(u.factor)
 
 
 def dimensionless(a: Any, what: str) -> None:

@@ -113,6 +113,10 @@ def numeric_value(v: Any, lex: Any = None, node: Any = None, _memo: dict | None 
                 return _memo["time"]
             raise NotConstant("time")
         decl = getattr(sym, "decl", None)
+        if decl is not None and decl.kind != KIND_PARAMETER and _memo is not None \
+                and _memo.get("fixed starts") and getattr(decl, "fixed", False) \
+                and isinstance(getattr(decl, "start", None), (int, float)):
+            return decl.start         # at initialization a fixed variable is its start value
         if decl is None or decl.kind != KIND_PARAMETER:
             raise NotConstant(f"{getattr(sym, 'name', sym)} is not a parameter")
         owner = getattr(sym, "owner", None)

@@ -147,7 +147,8 @@ def _parameter_value(a: Any, b: Any, ctx: Ctx, node: Any) -> bool:
         if decl is None or decl.kind != KIND_PARAMETER:
             return False
         try:
-            value = numeric_value(y, ctx.lex, node)
+            value = numeric_value(y, ctx.lex, node,
+                                  {"time": INITIAL_TIME, "fixed starts": True})
         except NotConstant:
             return False
         if isinstance(value, S.EnumValue):

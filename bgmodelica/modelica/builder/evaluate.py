@@ -78,8 +78,8 @@ def _ev_ref(node: A.Ref, ctx: Ctx) -> Any:
             raise NotConstant(name)
         val = _lexical_value(found, ctx, node)
     elif env is not None and name in env.view.elements and len(parts) > 1 \
-            and _unbuilt_child(env, name):
-        return _child_parameter(env, name, parts[1:], ctx, node)
+            and _unbuilt_child(env, name) and _child_parameter(env, name, parts[1:]):
+        return _child_parameter(env, name, parts[1:])[0]
     elif env is not None and name in env.view.elements:
         val = _env_member(env, name, ctx, node)
     elif env is not None and env.inst is not None and (
@@ -123,6 +123,8 @@ def _ev_ref(node: A.Ref, ctx: Ctx) -> Any:
 def _unbuilt_child(env: Env, name: str) -> bool:
     """Whether ``name`` is a subcomponent of ``env`` not built yet (a sibling's modifier
     reads its parameters: ``startTime = -vIn.rising``)."""
+    if name in env.disabled:
+        return False
     info = env.view.elements[name]
     if _category(info, type_ref(info)) != "child" or info.comp.dims:
         return False
@@ -130,20 +132,23 @@ def _unbuilt_child(env: Env, name: str) -> bool:
     return inst is None or name not in inst._children
 
 
-def _child_parameter(env: Env, name: str, rest: tuple, ctx: Ctx, node: Any) -> Any:
-    """A parameter of a subcomponent not built yet: its modifier here, else its class's
-    value."""
+def _child_parameter(env: Env, name: str, rest: tuple) -> tuple | None:
+    """``(value,)`` of a parameter of a subcomponent not built yet (its modifier here, else
+    its class's value), or None when ``rest`` does not name one."""
     (pname, subs), more = rest[0], rest[1:]
     if more or subs:
-        raise NotConstant(f"{name}.{pname}")
-    m = env.emod(name)
-    sub = m.sub.get(pname) if m is not None else None
-    if sub is not None and sub.has_binding:
-        return sub.value(True)
-    tref = type_ref(env.view.elements[name])
-    if tref.kind != "class" or tref.scope is None:
-        raise NotConstant(f"{name}.{pname}")
-    return static_env(tref.scope).numeric(pname)
+        return None
+    try:
+        m = env.emod(name)
+        sub = m.sub.get(pname) if m is not None else None
+        if sub is not None and sub.has_binding:
+            return (sub.value(True),)
+        tref = type_ref(env.view.elements[name])
+        if tref.kind != "class" or tref.scope is None:
+            return None
+        return (static_env(tref.scope).numeric(pname),)
+    except (NotConstant, KeyError):
+        return None
 
 
 def _map_member(val: list, name: str, ctx: Ctx, node: Any) -> list:
