@@ -445,6 +445,12 @@ def _modelica_path_options(argv: list[str]) -> list[str]:
         k += 1
     if folders:
         add_modelica_path(*folders)
+        # worker processes (sweeps on Dask, cosim) read the same libraries
+        import os
+
+        os.environ["MODELICAPATH"] = os.pathsep.join(
+            [str(Path(f).resolve()) for f in folders]
+            + [e for e in os.environ.get("MODELICAPATH", "").split(os.pathsep) if e])
     return rest
 
 
