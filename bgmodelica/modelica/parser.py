@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import threading
+import time
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -468,6 +469,7 @@ def parse_file(path: str | os.PathLike, disk_cache: bool = True) -> A.StoredDefi
     hit = _CACHE.get(key)
     if hit is not None and hit[0] == stamp:
         return hit[1]
+    started = time.perf_counter()
     tree = ast_cache.load(data, str(path)) if disk_cache else None
     if tree is None:
         if "\r" in text:                  # newlines as read_text would give them
@@ -475,5 +477,14 @@ def parse_file(path: str | os.PathLike, disk_cache: bool = True) -> A.StoredDefi
         tree, classes = _parse(text, str(path))
         if disk_cache:
             ast_cache.store(data, tree, classes)
+    _SECONDS[0] += time.perf_counter() - started
     _CACHE[key] = (stamp, tree)
     return tree
+
+
+_SECONDS = [0.0]
+
+
+def parse_seconds() -> float:
+    """Seconds this process spent parsing files or loading them from the disk cache."""
+    return _SECONDS[0]
