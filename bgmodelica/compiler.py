@@ -254,6 +254,7 @@ def _compile(model: Component, select: Selector | None, units: str = "error") ->
     check_alias_state_select(flat)
     raw = flat
     flat = eliminate_aliases(flat)
+    flat.asserts = raw.asserts
     lap("alias")
     try:
         balance = check_balance(flat)

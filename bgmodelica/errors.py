@@ -61,6 +61,11 @@ class SimulationError(ModelError):
         self.result = result
 
 
+class AssertionViolation(SimulationError):
+    """A model assertion (Modelica ``assert``) is false: the run stops at that output time;
+    ``result`` holds the rows before it."""
+
+
 class OptionError(ParameterError):
     """A simulation or command-line option is unusable (stop time, interval, tolerances,
     output file, plot variables or format, ``--arg`` value); the message names the option."""

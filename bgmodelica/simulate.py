@@ -9,6 +9,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
+from .asserts import check_asserts
 from .backends.casadi_dae import CasadiDAE
 from .backends.casadi_init import initialize
 from .compiler import CompiledModel, compile
@@ -157,6 +158,7 @@ def simulate(model: Component | CompiledModel | str, stop_time: float = 1.0,
             raise
         check_result(result, dae, p)
         result.meta.update(solver_meta)
+        check_asserts(compiled, result)
         return result
     init = initialize(dae, p, start_time)
     check_initial_point(dae, init.x0, init.z0, p, start_time)
@@ -192,6 +194,7 @@ def simulate(model: Component | CompiledModel | str, stop_time: float = 1.0,
             f"{solver.upper()} failed after t = {t_reached:g} s (last good output point): "
             f"{hint}.\nSolver said: {failure.strip().splitlines()[-1][:300]}",
             t_reached, result)
+    check_asserts(compiled, result)
     return result
 
 

@@ -153,6 +153,9 @@ class FlatModel:
     #: origin reads ``initial equation TEXT [component]``); carried to
     #: :attr:`bgmodelica.backends.casadi_dae.CasadiDAE.initial` by the compiler
     initial_equations: list[FlatEquation] = field(default_factory=list)
+    #: model assertions (:class:`bgmodelica.core.flatten_hybrid.FlatAssert`), checked on the
+    #: results (:mod:`bgmodelica.asserts`)
+    asserts: list = field(default_factory=list, repr=False, compare=False)
 
     def __repr__(self) -> str:
         """One line with the counts (the variables are in :attr:`variables`)."""

@@ -113,9 +113,11 @@ class _Flattener(ConnectionLowering):
                 prefix = f"{path}." if path else ""
                 stack.extend((child, prefix + child_name, elem)
                              for child_name, child in reversed(children.items()))
+        asserts: list = []
         if HYBRID_NODES[0]:
             self.pending, draft = flatten_hybrid.extract(self.pending, self.where)
             self.draft = None if draft.empty else draft
+            asserts = draft.asserts
         variables, parameters, inputs, discretes, symbols = self._collect_symbols()
         for fv in [v for v in variables if type(getattr(v.decl, "start", 0.0)) is str][:1]:
             raise start_text_error(fv.name, fv.decl)
@@ -134,6 +136,7 @@ class _Flattener(ConnectionLowering):
         flat = FlatModel(name, variables, parameters, inputs, self.equations,
                          discretes=discretes, hybrid=hybrid, sources=sources,
                          initial_equations=initial)
+        flat.asserts = [flatten_hybrid.lower_assert(a, here, self.full) for a, here in asserts]
         flat.remember_stacked(ca.vertcat(*self.columns) if self.columns else None,
                               *[take(self.all_sx, self._rows(entries)) for entries in self.entries])
         return flat

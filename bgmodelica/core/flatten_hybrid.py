@@ -17,7 +17,17 @@ import casadi as ca
 from ..errors import EquationError
 from .expr import RELATIONS, Equation, Expr, Leaf, Op, to_sx, to_text
 from .flatmodel import FlatBranch, FlatRelation, FlatSample, FlatTable, FlatWhen, HybridPart
-from .hybrid import _INITIAL, _TERMINAL, IfEquation, Reinit, SampleClock, TimeTable, When, _Special
+from .hybrid import (
+    _INITIAL,
+    _TERMINAL,
+    Assert,
+    IfEquation,
+    Reinit,
+    SampleClock,
+    TimeTable,
+    When,
+    _Special,
+)
 from .variables import KIND_PARAMETER, TIME, Boolean, Symbol
 
 
@@ -41,6 +51,7 @@ class HybridDraft:
     pres: dict[int, Symbol] = field(default_factory=dict)          # pre(...) symbols
     targets: dict[int, Symbol] = field(default_factory=dict)       # assigned in when
     target_where: dict[int, str] = field(default_factory=dict)
+    asserts: list[tuple[Assert, str]] = field(default_factory=list)   # not events: checked
 
     @property
     def empty(self) -> bool:
@@ -88,6 +99,9 @@ def extract(pending: list[tuple[Any, Any]], where: Callable[[Any], str]
                     draft.target_where[id(target)] = here
                     rw.scan(s.rhs, here, live=False)
             draft.whens.append((eq, here))
+            continue
+        if isinstance(eq, Assert):
+            draft.asserts.append((eq, here))
             continue
         if isinstance(eq, IfEquation):
             for e in _if_residuals(eq, here):
@@ -266,3 +280,36 @@ def _time_only(e: Any) -> bool:
     if isinstance(e, Op):
         return all(_time_only(a) for a in e.args)
     return True
+
+
+def lower_assert(a: Assert, here: str, full: dict[int, str]) -> FlatAssert:
+    """An assertion as an SX condition of one fresh symbol per quantity it reads, with their
+    names (full dotted names; ``time``)."""
+    symbols: list = []
+    names: list[str] = []
+    made: dict[int, ca.SX] = {}
+
+    def leaf(sym: Any) -> ca.SX:
+        got = made.get(id(sym))
+        if got is None:
+            name = "time" if sym is TIME else full.get(id(sym), getattr(sym, "name", "?"))
+            got = made[id(sym)] = ca.SX.sym(name)
+            symbols.append(got)
+            names.append(name)
+        return got
+
+    cond = to_sx(a.condition, leaf) if isinstance(a.condition, Expr) \
+        else ca.SX(float(a.condition))
+    return FlatAssert(cond, symbols, names, a.message, here, a.level)
+
+
+@dataclass
+class FlatAssert:
+    """A flattened assertion (:mod:`bgmodelica.asserts` checks it on results)."""
+
+    condition: ca.SX
+    symbols: list
+    names: list[str]
+    message: str
+    where: str
+    level: str = "error"

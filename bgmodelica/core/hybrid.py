@@ -341,6 +341,23 @@ def when(condition: Any, *statements: Any) -> When:
 
 
 @dataclass
+class Assert:
+    """``assert(condition, message)`` of a model: checked while simulating (see
+    :func:`assert_`)."""
+
+    condition: Any
+    message: str
+    level: str = "error"
+
+
+def assert_(condition: Any, message: str, level: str = "error") -> Assert:
+    """A model assertion: the simulation stops with ``message`` and the time at the first
+    output point where ``condition`` is false (``level="warning"``: a warning instead)."""
+    HYBRID_NODES[0] += 1
+    return Assert(condition, str(message), level)
+
+
+@dataclass
 class IfEquation:
     """``if c1 then eqs1 elseif c2 then eqs2 else eqs3 end if`` (see :func:`if_equation`)."""
 
