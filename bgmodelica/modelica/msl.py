@@ -1,5 +1,9 @@
 """The Modelica Standard Library subset: what ``Modelica.*`` names mean without the MSL sources.
 
+This is the fallback only: with a ``Modelica`` package on the library path (MODELICAPATH,
+``--modelica-path``; :mod:`.library_path`), ``Modelica.*`` names mean that source and this
+mapping is not used (one meaning per name).
+
 Two parts:
 
 - :data:`MAPPING`: MSL component classes (Electrical.Analog.Basic/Sources/Sensors/Ideal,
