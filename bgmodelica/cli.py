@@ -338,8 +338,10 @@ def build_parser() -> argparse.ArgumentParser:
     exp.add_argument("--type", choices=("me", "cs", "both"), default="me",
                      help="Model Exchange, Co-Simulation or both")
     exp.add_argument("-o", "--output", default="fmus", help="output directory (default fmus)")
-    exp.add_argument("--stop-time", type=float, default=1.0, help="DefaultExperiment stop [s]")
-    exp.add_argument("--step", type=float, default=None, help="DefaultExperiment step [s]")
+    exp.add_argument("--stop-time", type=float, default=None,
+                     help="DefaultExperiment stop [s] (default: the experiment annotation, 1)")
+    exp.add_argument("--step", type=float, default=None,
+                     help="DefaultExperiment step [s] (default: the experiment annotation)")
     exp.add_argument("--validate", action="store_true", help="run fmpy's validate_fmu")
     exp.add_argument("--static-states", action="store_true",
                      help="export a model that needs dynamic state selection with its compiled "

@@ -12,8 +12,9 @@ _TYPES = {"me": "me", "cs": "cs", "both": "both", "me+cs": "both"}
 
 
 def export_fmu(model: Any, folder: str | Path = ".", fmi_version: str | int = "2.0",
-               fmi_type: str = "ME", *, stop_time: float = 1.0, step_size: float | None = None,
-               tolerance: float = 1e-6, static_states: bool = False,
+               fmi_type: str = "ME", *, stop_time: float | None = None,
+               step_size: float | None = None, tolerance: float | None = None,
+               static_states: bool = False,
                units: str = "error") -> Path:
     """Export ``model`` as ``<folder>/<model name>.fmu`` and return its path.
 
@@ -22,7 +23,8 @@ def export_fmu(model: Any, folder: str | Path = ".", fmi_version: str | int = "2
     ``"file.mo:Package.Model"``). fmi_version: ``"2.0"`` or ``"3.0"`` (2 and 3 too). fmi_type:
     ``"ME"`` (Model Exchange), ``"CS"`` (Co-Simulation with the embedded BDF solver) or ``"both"``.
     stop_time [s], step_size [s] (optional) and tolerance: the default experiment written into
-    ``modelDescription.xml`` (and the CS solver's tolerance). static_states: export a model whose
+    ``modelDescription.xml`` (and the CS solver's tolerance); left None, the model's experiment
+    annotation gives them (else 1 s and 1e-6). static_states: export a model whose
     state choice could change during a simulation anyway (see
     :func:`bgmodelica.fmi.from_model.fmu_spec`). units: the unit check when ``model`` is compiled
     here. The folder is made if missing.

@@ -412,8 +412,8 @@ def nested_user_error(err: UserCodeError, key: str, cls: str) -> UserCodeError:
 def check_export_args(args: Any) -> None:
     """``bgmodelica export`` options: a finite positive stop time and step, and an output
     directory that is not a file."""
-    t1 = _real("--stop-time", args.stop_time)
-    if t1 <= 0:
+    t1 = _real("--stop-time", args.stop_time, allow_none=True)
+    if t1 is not None and t1 <= 0:
         raise OptionError(f"--stop-time = {t1:g} must be positive")
     step = _real("--step", args.step, allow_none=True)
     if step is not None and step <= 0:

@@ -241,12 +241,32 @@ def _init_function(dae, p_all, t, u, p) -> ca.Function | None:
     return ca.Function("init", [t, u, p], [f0(t, ca.vertcat(p, u))], ["t", "u", "p"], ["x0"])
 
 
+def default_experiment(compiled: CompiledModel, stop_time: float | None = None,
+                       step_size: float | None = None, tolerance: float | None = None
+                       ) -> dict[str, float | None]:
+    """The FMU's DefaultExperiment: the values given, else the model's ``experiment``
+    annotation (Modelica models: StartTime, StopTime, Interval, Tolerance), else a stop time
+    of 1 s and a tolerance of 1e-6."""
+    from ..modelica import experiment_of
+
+    exp = experiment_of(compiled.source) if compiled.source is not None else {}
+    start = float(exp.get("start_time", 0.0))
+    stop = stop_time if stop_time is not None else exp.get("stop_time", start + 1.0)
+    return {"start_time": start, "stop_time": float(stop),
+            "step_size": step_size if step_size is not None else exp.get("interval"),
+            "tolerance": float(tolerance if tolerance is not None else exp.get("rtol", 1e-6))}
+
+
 def export_model(model: Component | CompiledModel, out_dir: str | Path, *,
-                 fmi_version: int = 2, fmu_type: str = "me", stop_time: float = 1.0,
-                 step_size: float | None = None, tolerance: float = 1e-6,
+                 fmi_version: int = 2, fmu_type: str = "me", stop_time: float | None = None,
+                 step_size: float | None = None, tolerance: float | None = None,
                  static_states: bool = False) -> Path:
-    """Compile (if needed) and export ``model`` as an FMU into ``out_dir``; returns its path
-    (``static_states``: see :func:`fmu_spec`)."""
-    spec = fmu_spec(model, stop_time=stop_time, step_size=step_size, tolerance=tolerance,
-                    static_states=static_states)
+    """Compile (if needed) and export ``model`` as an FMU into ``out_dir``; returns its path.
+    ``stop_time``, ``step_size`` and ``tolerance`` left None come from the model's experiment
+    annotation (:func:`default_experiment`); ``static_states``: see :func:`fmu_spec`."""
+    compiled = model if isinstance(model, CompiledModel) else compile(model)
+    exp = default_experiment(compiled, stop_time, step_size, tolerance)
+    spec = fmu_spec(compiled, stop_time=exp["stop_time"], step_size=exp["step_size"],
+                    tolerance=exp["tolerance"], static_states=static_states)
+    spec.start_time = exp["start_time"]
     return export_fmu(spec, out_dir, fmi_version=fmi_version, fmu_type=fmu_type)

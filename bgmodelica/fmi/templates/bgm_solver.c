@@ -174,7 +174,7 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
     double *D = b->d, *J = b->jac, *LU = c->ws, *ypred = LU + BGM_NXA * BGM_NXA;
     double *psi = ypred + BGM_NXA, *d = psi + BGM_NXA, *ynew = d + BGM_NXA, *f = ynew + BGM_NXA;
     double *dy = f + BGM_NXA, *sc = dy + BGM_NXA, *tmp = sc + BGM_NXA, *y0 = tmp + BGM_NXA;
-    double rtol = c->v.solver_tol, hmax = c->v.solver_hmax, newton_tol, t_bound;
+    double rtol = c->v.solver_tol, hmax = c->v.solver_hmax, newton_tol, newton_floor, t_bound;
     long substeps = 0;
 #if BGM_HYBRID
     const int overshoot = 0;
@@ -193,6 +193,8 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
     }
     newton_tol = sqrt(rtol) < 0.03 ? sqrt(rtol) : 0.03;
     if (newton_tol < 10.0 * EPS / rtol) newton_tol = 10.0 * EPS / rtol;
+    newton_floor = 100.0 * EPS / rtol < 1e-3 * newton_tol ? 100.0 * EPS / rtol
+                                                          : 1e-3 * newton_tol;
     /* steps may pass t_end (not in hybrid models), whatever the importer's stop time */
     t_bound = overshoot ? INFINITY : t_end;
 
@@ -312,6 +314,17 @@ bgm_status bgm_integrate(bgm_inst *c, const char *fn, double t_end) {
                 dy_norm = bgm_wnorm(dy, sc, n);
                 if (!isfinite(dy_norm)) {
                     why = "Newton iteration diverged";
+                    break;
+                }
+                if (dy_norm <= newton_floor) {
+                    /* an update at the level of rounding (a steady state): its ratio to the
+                       previous one is noise, not a rate of convergence */
+                    for (i = 0; i < n; i++) {
+                        ynew[i] += dy[i];
+                        d[i] += dy[i];
+                    }
+                    n_iter = k + 1;
+                    converged = 1;
                     break;
                 }
                 if (k > 0) {
