@@ -92,7 +92,7 @@ def test_no_library_on_the_path(tmp_path, monkeypatch):
 
 
 def test_cli_takes_library_names_and_modelica_path(lib, tmp_path, monkeypatch, capsys):
-    monkeypatch.delenv("MODELICAPATH")
+    monkeypatch.setenv("MODELICAPATH", "")        # restored after the test: main() sets it
     LP.clear()
     out = tmp_path / "twice.csv"
     code = main(["simulate", "Lib.Examples.Twice", "--modelica-path", str(lib), "-o",
@@ -104,6 +104,7 @@ def test_cli_takes_library_names_and_modelica_path(lib, tmp_path, monkeypatch, c
     assert float(last[0]) == pytest.approx(2.0)
 
 
-def test_modelica_path_must_exist(capsys):
+def test_modelica_path_must_exist(capsys, monkeypatch):
+    monkeypatch.setenv("MODELICAPATH", "")
     assert main(["check", "Lib.X", "--modelica-path", "/nonexistent/folder"]) == 2
     assert "no such folder" in capsys.readouterr().err

@@ -88,7 +88,7 @@ def test_rc_of_msl_parts_composed_in_python(msl):
 
 
 def test_cli_takes_an_msl_class(tmp_path, monkeypatch, capsys):
-    monkeypatch.delenv("MODELICAPATH", raising=False)
+    monkeypatch.setenv("MODELICAPATH", "")        # restored after the test: main() sets it
     monkeypatch.setattr(LP, "_extra", [])
     LP.clear()
     out = tmp_path / "first.csv"
