@@ -41,7 +41,7 @@ def _load(stored: Any, name: str | None, kwargs: dict[str, Any]):
     if name is None:
         models = B.list_models(file)
         if len(models) != 1:
-            raise ModelicaError(f"{stored.file}: name the model to load (it defines "
+            raise ModelicaError(f"{stored.file}:1:1: name the model to load (it defines "
                                 f"{', '.join(models) or 'no models'})")
         name = models[0]
     return _instantiate(B.find_class(file, name), name, stored.file, kwargs)

@@ -20,6 +20,7 @@ from .classes import (
     ClassView,
     ElemInfo,
     TypeRef,
+    check_not_final,
     class_view,
     constraining_mod,
     resolve_class,
@@ -63,6 +64,7 @@ def instantiate(view: ClassView, mods: dict[str, Mod], parent: Env | None, path:
             raise fail(m.lex or where, m.pos if m.pos != (0, 0) else pos,
                        f"{view.scope.full_name} has no element {name!r} to modify; it has: "
                        f"{', '.join(view.elements) or 'none'}")
+        check_not_final(view.elements[name], mods[name])
     plan = view.plan
     if plan is not None and not any(m.redeclare is not None for m in mods.values()):
         arrays, scalars, children, cls = plan

@@ -1,0 +1,10 @@
+// expect: 3 extends
+model A
+  extends B;
+end A;
+model B
+  extends A;
+end B;
+model M
+  A a;
+end M;
