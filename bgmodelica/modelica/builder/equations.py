@@ -16,6 +16,7 @@ from ..errors import ModelicaError
 from .base import Ctx, NotConstant, _Disabled, _is_number, fail, numeric_value
 from .env import Env
 from .evaluate import _iterate, evaluate
+from .types import check_condition
 
 
 def _equation(a: Any, b: Any, ctx: Ctx, node: Any, out: list) -> None:
@@ -263,6 +264,7 @@ def _own_output(x: Any, ctx: Ctx) -> bool | None:
 def _eval_if_equation(eq: A.EqIf, ctx: Ctx, out: list, initial: bool) -> None:
     symbolic = []
     for cond, body in eq.branches:
+        check_condition(cond, ctx, "an if-equation")
         try:
             c = numeric_value(evaluate(cond, Ctx(ctx.env, ctx.lex, ctx.loops, True)), ctx.lex,
                               cond)

@@ -16,6 +16,7 @@ from .. import scope as S
 from .arith import _flatten, _num_or_expr, _shape, _sum
 from .base import Ctx, NotConstant, fail, numeric_value
 from .evaluate import _comprehension, evaluate
+from .types import check_der_argument
 
 
 def _ev_call(node: A.Call, ctx: Ctx) -> Any:
@@ -146,6 +147,7 @@ def _symbolic(ctx: Ctx, node: Any, name: str) -> None:
 
 def _fn_der(node: A.Call, ctx: Ctx) -> Any:
     _symbolic(ctx, node, "der")
+    check_der_argument(node, ctx)
     (x,) = _args(node, ctx, 1, "der")
     try:
         return _elementwise(X.der)(x)

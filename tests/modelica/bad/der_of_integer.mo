@@ -1,7 +1,7 @@
 // expect: 6 der
 model M
-  parameter Real p = 1;
+  parameter Integer n = 3;
   Real x;
 equation
-  x = der(p);
+  x = der(n);
 end M;
