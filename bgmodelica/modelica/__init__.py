@@ -37,6 +37,7 @@ def _load(stored: Any, name: str | None, kwargs: dict[str, Any]):
     from . import builder as B
     from .scope import FileScope
 
+    _check_within(stored)
     file = FileScope(stored)
     if name is None:
         models = B.list_models(file)
@@ -45,6 +46,26 @@ def _load(stored: Any, name: str | None, kwargs: dict[str, Any]):
                                 f"{', '.join(models) or 'no models'})")
         name = models[0]
     return _instantiate(B.find_class(file, name), name, stored.file, kwargs)
+
+
+def _check_within(stored: Any) -> None:
+    """The package a file's ``within`` clause names must exist (on the library path) when
+    the file is not read as part of that package's folder."""
+    from .library_path import locate, resolve
+
+    within = stored.within or ""
+    if not within:
+        return
+    line, col = getattr(within, "pos", (1, 1))
+    head = within.partition(".")[0]
+    if locate(head) is None:
+        raise ModelicaError(f"{stored.file}:{line}:{col}: within {within}: no package {head} "
+                            "on the Modelica library path (the within clause names the "
+                            "package the file belongs to)")
+    got = resolve(str(within))
+    if got is None or getattr(getattr(got, "cdef", None), "kind", "") != "package":
+        raise ModelicaError(f"{stored.file}:{line}:{col}: within {within}: no such package "
+                            f"in the library {head}")
 
 
 def _instantiate(scope: Any, name: str, where: str, kwargs: dict[str, Any]):

@@ -79,7 +79,7 @@ class _ToAst(StatementRules):
         return A.StoredDefinition(self.file, within, classes)
 
     def within_clause(self, ch):
-        return str(ch[0]) if ch else ""
+        return ch[0] if ch else ""      # a _Name: its position names the clause in messages
 
     def name(self, ch):
         out = _Name(".".join(ident_text(t) for t in ch))

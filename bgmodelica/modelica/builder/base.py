@@ -49,6 +49,19 @@ def _where(lex: S.ClassScope | None, pos: A.Pos) -> str:
     return f"{lex.cdef.file or lex.file.file}:{pos[0]}:{pos[1]}"
 
 
+#: the most elements an array (a declaration, fill()/zeros()/ones(), a range) may have: the
+#: builder makes a Python object per element, so a larger array would exhaust time and memory
+#: before any message; it is refused when its size is known, before anything is allocated
+MAX_ARRAY_ELEMENTS = 10**6
+
+
+def check_array_size(count: int, lex: S.ClassScope | None, node: Any, what: str) -> None:
+    """Refuse an array of more than :data:`MAX_ARRAY_ELEMENTS` elements."""
+    if count > MAX_ARRAY_ELEMENTS:
+        raise fail(lex, node, f"array too large: {what} would have {count:,} elements (the "
+                   f"limit is {MAX_ARRAY_ELEMENTS:,})")
+
+
 def fail(lex: S.ClassScope | None, node: Any, message: str) -> ModelicaError:
     pos = getattr(node, "pos", None)
     if pos is None:

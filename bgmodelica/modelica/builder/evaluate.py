@@ -19,7 +19,7 @@ from .arith import (
     _neg,
     _relation,
 )
-from .base import Ctx, NotConstant, _Disabled, fail, numeric_value
+from .base import Ctx, NotConstant, _Disabled, check_array_size, fail, numeric_value
 from .classes import class_view, type_ref
 from .env import Env, _category, static_env
 from .types import check_condition, check_number_operands
@@ -398,10 +398,13 @@ def _ev_range(node: A.Range, ctx: Ctx) -> Any:
     if all(isinstance(v, int) and not isinstance(v, bool) for v in (start, stop, step)):
         if step == 0:
             raise fail(ctx.lex, node, "range step is zero")
-        return list(range(start, stop + (1 if step > 0 else -1), step))
+        out = range(start, stop + (1 if step > 0 else -1), step)
+        check_array_size(len(out), ctx.lex, node, "the range")
+        return list(out)
     if step == 0:
         raise fail(ctx.lex, node, "range step is zero")
     n = int(math.floor((stop - start) / step + 1e-12)) + 1
+    check_array_size(n, ctx.lex, node, "the range")
     return [start + k * step for k in range(max(n, 0))]
 
 

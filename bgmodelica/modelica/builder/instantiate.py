@@ -343,6 +343,29 @@ def _make_msl(msl: S.MslClass, m: Mod | None, path: str, info: ElemInfo) -> Elem
     return inst
 
 
+_EXPERIMENT = ("StartTime", "StopTime", "Interval", "Tolerance")
+
+
+def _experiment_value(sub: A.ElementMod, scope: S.ClassScope) -> float | None:
+    """The number of one ``experiment`` setting (None for settings of other tools); a value
+    of a standard setting that is not a number is an error."""
+    try:
+        v = numeric_value(evaluate(sub.mod.binding, Ctx(None, scope, {}, True)))
+    except NotConstant:
+        v = None
+    except ModelicaError:
+        if sub.name in _EXPERIMENT:
+            raise
+        return None
+    if isinstance(v, (int, float)) and not isinstance(v, bool):
+        return float(v)
+    if sub.name in _EXPERIMENT:
+        raise fail(scope, sub.mod.binding, f"experiment {sub.name} must be a number, got "
+                   + (repr(v) if v is not None else "an expression not known before "
+                      "simulation"))
+    return None
+
+
 def experiment(scope: S.ClassScope) -> dict[str, float]:
     """``annotation(experiment(StartTime=, StopTime=, Interval=, Tolerance=))`` of a class
     (inherited through ``extends``)."""
@@ -354,13 +377,9 @@ def experiment(scope: S.ClassScope) -> dict[str, float]:
                 for sub in arg.mod.args:
                     if isinstance(sub, A.ElementMod) and sub.mod is not None \
                             and sub.mod.binding is not None:
-                        try:
-                            v = numeric_value(evaluate(sub.mod.binding,
-                                                       Ctx(None, scope, {}, True)))
-                        except (NotConstant, ModelicaError):
-                            continue
-                        if isinstance(v, (int, float)) and not isinstance(v, bool):
-                            out[sub.name] = float(v)
+                        v = _experiment_value(sub, scope)
+                        if v is not None:
+                            out[sub.name] = v
     if not out:
         for el in cdef.elements:
             if isinstance(el, A.Extends):
