@@ -79,23 +79,37 @@ def _instantiate(scope: Any, name: str, where: str, kwargs: dict[str, Any]):
     try:
         with gc_paused():                      # as a Python model's constructor is
             model = B.instantiate(view, B.top_mods(kwargs), None, "", scope, scope.cdef.pos)
-    except RecursionError:
-        raise ModelicaError(f"{where}: {name}: the class hierarchy is too deep or "
-                            "recursive") from None
+        exp = B.experiment(scope)
     except ModelError:
         raise
-    exp = B.experiment(scope)
+    except (B.NotConstant, *B.INTERNAL_ERRORS) as err:
+        raise _internal(err, scope, name, where) from None
     object.__setattr__(model, "_mo_experiment", exp)
     if "experiment" not in model._symbols and "experiment" not in model._children:
         object.__setattr__(model, "experiment", exp)
     object.__setattr__(model, "_mo_source", (scope.cdef.file or where, scope.full_name))
+    line, col = scope.cdef.pos
+    object.__setattr__(model, "_mo_where", f"{scope.cdef.file or where}:{line}:{col}: "
+                                           f"{scope.full_name}")
     return model
+
+
+def _internal(err: BaseException, scope: Any, name: str, where: str) -> ModelicaError:
+    """An exception that escaped the builder, as one line at the class being instantiated
+    (the best position known: the constructs themselves convert their own errors)."""
+    from .builder.base import describe_internal
+
+    line, col = getattr(getattr(scope, "cdef", None), "pos", (1, 1))
+    file = getattr(getattr(scope, "cdef", None), "file", "") or where
+    return ModelicaError(f"{file}:{line}:{col}: {name}: {describe_internal(err)}")
 
 
 def load_class(name: str, **modifiers: Any):
     """Instantiate the class ``name`` (fully qualified, e.g.
     ``"Modelica.Mechanics.Rotational.Examples.First"``) of a library on the library path
     (:func:`add_modelica_path`, ``MODELICAPATH``); ``modifiers`` as in :func:`load_modelica`."""
+    from ..errors import ModelError
+    from .builder.base import INTERNAL_ERRORS, describe_internal
     from .library_path import locate, modelica_path, resolve
 
     head = name.partition(".")[0]
@@ -104,7 +118,12 @@ def load_class(name: str, **modifiers: Any):
             "use --modelica-path DIR"
         raise ModelicaError(f"{name}: no package {head} on the Modelica library path "
                             f"({where})")
-    scope = resolve(name)
+    try:
+        scope = resolve(name)
+    except ModelError:
+        raise
+    except INTERNAL_ERRORS as err:
+        raise ModelicaError(f"{name}: {describe_internal(err)}") from None
     if scope is None or not hasattr(scope, "cdef"):
         raise ModelicaError(f"{name}: no such class in the library {head}"
                             f"{_did_you_mean(name)}")

@@ -16,7 +16,7 @@ from ...core.variables import (
 )
 from .. import ast as A
 from .. import scope as S
-from ..errors import ModelicaError
+from ..errors import ModelicaError, internal_text
 
 if TYPE_CHECKING:
     from .env import Env
@@ -60,6 +60,20 @@ def check_array_size(count: int, lex: S.ClassScope | None, node: Any, what: str)
     if count > MAX_ARRAY_ELEMENTS:
         raise fail(lex, node, f"array too large: {what} would have {count:,} elements (the "
                    f"limit is {MAX_ARRAY_ELEMENTS:,})")
+
+
+#: exceptions of Python, CasADi or the builder itself that a construct the builder does not
+#: handle can raise; where the construct is known they become a :class:`ModelicaError` with
+#: its position (a traceback is never the answer to a Modelica text)
+INTERNAL_ERRORS = (RecursionError, KeyError, IndexError, TypeError, ValueError,
+                   AttributeError, ZeroDivisionError, OverflowError, RuntimeError)
+
+
+def describe_internal(err: BaseException) -> str:
+    """One line for an internal exception: what failed, in the builder's words."""
+    if isinstance(err, NotConstant):
+        return f"a value is not known when the model is built: {err.what}"
+    return internal_text(err)
 
 
 def fail(lex: S.ClassScope | None, node: Any, message: str) -> ModelicaError:

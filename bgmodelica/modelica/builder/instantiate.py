@@ -280,6 +280,16 @@ def _make_class(view: ClassView, decls: dict[str, Any], connector: bool) -> type
         raise fail(view.scope, view.cdef, str(err)) from None
 
 
+def _check_not_recursive(tref: TypeRef, env: Env, info: ElemInfo) -> None:
+    """A component of a class that encloses it (``model M  M m; end M;``) would be infinite."""
+    e: Env | None = env
+    while e is not None:
+        if e.view.scope is tref.scope:
+            raise fail(info.lex, info.comp, f"component {info.comp.name} is recursive: its "
+                       f"class {tref.scope.full_name} contains it")
+        e = e.parent
+
+
 def _make_child(tref: TypeRef, m: Mod | None, env: Env, path: str, info: ElemInfo) -> Element:
     if m is not None and m.has_binding:
         raise fail(m.lex or info.lex, m.pos, f"{info.comp.name}: a component cannot be bound "
@@ -288,6 +298,7 @@ def _make_child(tref: TypeRef, m: Mod | None, env: Env, path: str, info: ElemInf
         view = class_view(tref.scope)
         if view.kind == "package":
             raise fail(info.lex, info.comp, f"{tref.name} is a package, not a type")
+        _check_not_recursive(tref, env, info)
         return instantiate(view, dict(m.sub) if m is not None else {}, env, path, info.lex,
                            info.comp.pos)
     if tref.kind == "msl":
