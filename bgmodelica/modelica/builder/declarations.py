@@ -254,8 +254,10 @@ def _override(decl: Any, m: Mod, info: ElemInfo, tref: TypeRef) -> Any:
         elif _is_number(value):
             value = float(value)
         elif isinstance(value, (list, Element, str)):
-            raise fail(m.lex or info.lex, m.pos, f"parameter {comp.name} is bound to "
-                       f"{type(value).__name__} {value!r}")
+            what = {"str": "the String", "list": "the array"}.get(type(value).__name__,
+                                                                   "the component")
+            raise fail(m.lex or info.lex, m.pos, f"parameter {comp.name} is a number and "
+                       f"cannot be given {what} {value!r}")
         changes["value"] = value
     if m.sub:
         attrs = _attr_values(m, True, info.lex, comp)

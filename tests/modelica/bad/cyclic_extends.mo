@@ -1,4 +1,4 @@
-// expect: 3 extends
+// expect: 2 extends itself
 model A
   extends B;
 end A;

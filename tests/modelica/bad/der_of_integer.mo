@@ -1,4 +1,4 @@
-// expect: 6 der
+// expect: 6 der()
 model M
   parameter Integer n = 3;
   Real x;

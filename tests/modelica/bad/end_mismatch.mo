@@ -1,4 +1,5 @@
-// expect: 6 end_mismatch
+// model: end_mismatch
+// expect: 7 closed by
 model end_mismatch
   Real x;
 equation

@@ -1,4 +1,4 @@
-// expect: 7 while
+// expect: 8 endless loop
 model M
   parameter Real p = 1;
   Real x;

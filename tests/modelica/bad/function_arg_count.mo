@@ -1,4 +1,4 @@
-// expect: 9 argument
+// expect: 9 input(s)
 function f
   input Real a;
   output Real y;

@@ -1,4 +1,4 @@
-// expect: 4 negative
+// expect: 4 non-negative
 model M
   parameter Integer n = -2;
   Real x[n];

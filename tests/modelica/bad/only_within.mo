@@ -1,2 +1,2 @@
-// expect: 2 no class
+// expect: 1 no class
 within;

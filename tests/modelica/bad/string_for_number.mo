@@ -1,4 +1,4 @@
-// expect: 6 string
+// expect: 6 String
 model A
   parameter Real k = 1;
 end A;

@@ -1,4 +1,4 @@
-// expect: 6 equation
+// expect: 2 unbalanced
 model M
   Real x;
 equation
