@@ -87,6 +87,9 @@ def run_one(name: str, out_dir: Path) -> dict:
         result = bg.simulate(compiled, **exp)
         row["simulate"] = time.perf_counter() - t2
     except Exception as err:  # noqa: BLE001
+        from bgmodelica.modelica.errors import locate_error
+
+        locate_error(model, err)            # the example's file:line when none is named
         row["error"] = _one_line(err)
         return row
     row["simulated"] = True

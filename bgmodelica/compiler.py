@@ -13,7 +13,7 @@ from .backends.casadi_dae import CasadiDAE, attach_initial_equations, build_dae
 from .core.component import Component
 from .core.flatmodel import FlatModel
 from .core.flatten import flatten
-from .errors import DeclarationError, UnbalancedModelError
+from .errors import DeclarationError, ModelError, UnbalancedModelError
 from .passes.alias import eliminate_aliases
 from .passes.balance import BalanceReport, check_balance
 from .passes.index_reduction import ReducedModel, Selector, reduce_index
@@ -188,17 +188,31 @@ def compile(model: Component | str, *, select: Selector | None = None,  # noqa: 
         from .loader import load_model
 
         model = load_model(model)
-    if select is None and array_path:
-        from .array_path import compile_arrays
+    try:
+        if select is None and array_path:
+            from .array_path import compile_arrays
 
-        with gc_paused():
-            fast = compile_arrays(model, units)
-        if fast is not None:
-            return fast
-    if cache is False or cache is None or select is not None:
-        with gc_paused():
-            return _compile(model, select, units)
-    return _compile_cached(model, units, cache)
+            with gc_paused():
+                fast = compile_arrays(model, units)
+            if fast is not None:
+                return fast
+        if cache is False or cache is None or select is not None:
+            with gc_paused():
+                return _compile(model, select, units)
+        return _compile_cached(model, units, cache)
+    except ModelError as err:
+        from .modelica.errors import locate_error
+
+        locate_error(model, err)                  # a model read from Modelica: its class
+        raise
+    except (RecursionError, RuntimeError, KeyError, IndexError, TypeError, ValueError,
+            AttributeError, ZeroDivisionError) as err:
+        from .modelica.errors import compile_failure
+
+        located = compile_failure(model, err)    # a model read from Modelica: one line
+        if located is None:
+            raise
+        raise located from None
 
 
 def _compile_cached(model: Component, units: str, cache: bool | str | Path) -> CompiledModel:

@@ -37,14 +37,35 @@ def _load(stored: Any, name: str | None, kwargs: dict[str, Any]):
     from . import builder as B
     from .scope import FileScope
 
+    _check_within(stored)
     file = FileScope(stored)
     if name is None:
         models = B.list_models(file)
         if len(models) != 1:
-            raise ModelicaError(f"{stored.file}: name the model to load (it defines "
+            raise ModelicaError(f"{stored.file}:1:1: name the model to load (it defines "
                                 f"{', '.join(models) or 'no models'})")
         name = models[0]
     return _instantiate(B.find_class(file, name), name, stored.file, kwargs)
+
+
+def _check_within(stored: Any) -> None:
+    """The package a file's ``within`` clause names must exist (on the library path) when
+    the file is not read as part of that package's folder."""
+    from .library_path import locate, resolve
+
+    within = stored.within or ""
+    if not within:
+        return
+    line, col = getattr(within, "pos", (1, 1))
+    head = within.partition(".")[0]
+    if locate(head) is None:
+        raise ModelicaError(f"{stored.file}:{line}:{col}: within {within}: no package {head} "
+                            "on the Modelica library path (the within clause names the "
+                            "package the file belongs to)")
+    got = resolve(str(within))
+    if got is None or getattr(getattr(got, "cdef", None), "kind", "") != "package":
+        raise ModelicaError(f"{stored.file}:{line}:{col}: within {within}: no such package "
+                            f"in the library {head}")
 
 
 def _instantiate(scope: Any, name: str, where: str, kwargs: dict[str, Any]):
@@ -58,23 +79,37 @@ def _instantiate(scope: Any, name: str, where: str, kwargs: dict[str, Any]):
     try:
         with gc_paused():                      # as a Python model's constructor is
             model = B.instantiate(view, B.top_mods(kwargs), None, "", scope, scope.cdef.pos)
-    except RecursionError:
-        raise ModelicaError(f"{where}: {name}: the class hierarchy is too deep or "
-                            "recursive") from None
+        exp = B.experiment(scope)
     except ModelError:
         raise
-    exp = B.experiment(scope)
+    except (B.NotConstant, *B.INTERNAL_ERRORS) as err:
+        raise _internal(err, scope, name, where) from None
     object.__setattr__(model, "_mo_experiment", exp)
     if "experiment" not in model._symbols and "experiment" not in model._children:
         object.__setattr__(model, "experiment", exp)
     object.__setattr__(model, "_mo_source", (scope.cdef.file or where, scope.full_name))
+    line, col = scope.cdef.pos
+    object.__setattr__(model, "_mo_where", f"{scope.cdef.file or where}:{line}:{col}: "
+                                           f"{scope.full_name}")
     return model
+
+
+def _internal(err: BaseException, scope: Any, name: str, where: str) -> ModelicaError:
+    """An exception that escaped the builder, as one line at the class being instantiated
+    (the best position known: the constructs themselves convert their own errors)."""
+    from .builder.base import describe_internal
+
+    line, col = getattr(getattr(scope, "cdef", None), "pos", (1, 1))
+    file = getattr(getattr(scope, "cdef", None), "file", "") or where
+    return ModelicaError(f"{file}:{line}:{col}: {name}: {describe_internal(err)}")
 
 
 def load_class(name: str, **modifiers: Any):
     """Instantiate the class ``name`` (fully qualified, e.g.
     ``"Modelica.Mechanics.Rotational.Examples.First"``) of a library on the library path
     (:func:`add_modelica_path`, ``MODELICAPATH``); ``modifiers`` as in :func:`load_modelica`."""
+    from ..errors import ModelError
+    from .builder.base import INTERNAL_ERRORS, describe_internal
     from .library_path import locate, modelica_path, resolve
 
     head = name.partition(".")[0]
@@ -83,7 +118,12 @@ def load_class(name: str, **modifiers: Any):
             "use --modelica-path DIR"
         raise ModelicaError(f"{name}: no package {head} on the Modelica library path "
                             f"({where})")
-    scope = resolve(name)
+    try:
+        scope = resolve(name)
+    except ModelError:
+        raise
+    except INTERNAL_ERRORS as err:
+        raise ModelicaError(f"{name}: {describe_internal(err)}") from None
     if scope is None or not hasattr(scope, "cdef"):
         raise ModelicaError(f"{name}: no such class in the library {head}"
                             f"{_did_you_mean(name)}")

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import re
+from typing import Any
+
 from ..errors import ModelLoadError
 
 
@@ -24,3 +27,40 @@ class ModelicaSyntaxError(ModelicaError):
 
 class ModelicaExportError(ModelicaError):
     """A model cannot be written as Modelica (names the construct and the component)."""
+
+
+def internal_text(err: BaseException) -> str:
+    """One short line for an exception of Python or CasADi that a Modelica construct caused:
+    its type and the gist of its message (CasADi's source locations dropped)."""
+    if isinstance(err, RecursionError):
+        return "nested too deeply (recursion limit reached; a recursive definition or a " \
+            "very deep expression?)"
+    lines = [ln for ln in str(err).splitlines() if ln.strip()]
+    text = lines[-1] if lines else ""
+    text = re.sub(r"^(\S*\.(?:cpp|hpp|h):\d+:\s*)+", "", text.strip())
+    text = " ".join(text.split())
+    if len(text) > 200:
+        text = text[:200] + "..."
+    return f"unsupported construct or internal error ({type(err).__name__}: {text})"
+
+
+def compile_failure(model: Any, err: BaseException) -> ModelicaError | None:
+    """For a model read from Modelica, an internal exception of its compilation as one line
+    at the model's class (None for other models)."""
+    where = getattr(model, "__dict__", {}).get("_mo_where")
+    if where is None:
+        return None
+    return ModelicaError(f"{where}: cannot compile this model: {internal_text(err)}")
+
+
+def locate_error(model: Any, err: BaseException) -> None:
+    """Prefix the message of ``err`` (raised while compiling ``model``) with the position of
+    the model's class when the model was read from Modelica and the message names no
+    Modelica source position."""
+    where = getattr(model, "__dict__", {}).get("_mo_where")
+    if where is None or not err.args or _POSITION.search(str(err)):
+        return
+    err.args = (f"{where}: {err.args[0]}", *err.args[1:])
+
+
+_POSITION = re.compile(r"\.mo:\d+")

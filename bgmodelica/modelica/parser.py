@@ -80,7 +80,7 @@ class _ToAst(StatementRules):
         return A.StoredDefinition(self.file, within, classes)
 
     def within_clause(self, ch):
-        return str(ch[0]) if ch else ""
+        return ch[0] if ch else ""      # a _Name: its position names the clause in messages
 
     def name(self, ch):
         out = _Name(".".join(ident_text(t) for t in ch))
@@ -373,8 +373,21 @@ def _constrain(body: Any, rest: list) -> None:
         item.annotation = item.annotation or ann
 
 
+#: the largest Modelica text read (bytes), about 15 times the largest file of the Modelica
+#: Standard Library; a larger file is refused at once rather than parsed for minutes
+MAX_TEXT_BYTES = 10 * 2**20
+
+
+def _check_size(size: int, file: str) -> None:
+    if size > MAX_TEXT_BYTES:
+        raise ModelicaSyntaxError(file, 1, 1, f"file too large: {size / 2**20:.1f} MB of "
+                                  f"Modelica text (the limit is {MAX_TEXT_BYTES // 2**20} MB; "
+                                  "split it into packages)")
+
+
 def parse_text(text: str, file: str = "<string>") -> A.StoredDefinition:
     """Parse Modelica ``text``; ``file`` names it in error messages."""
+    _check_size(len(text), file)
     return _parse(text, file)[0]
 
 
@@ -457,13 +470,16 @@ def parse_file(path: str | os.PathLike, disk_cache: bool = True) -> A.StoredDefi
     p = Path(path)
     try:
         st = p.stat()
+        _check_size(st.st_size, str(path))
         data = p.read_bytes()
         text = data.decode("utf-8")
     except OSError as err:
         raise ModelicaError(f"cannot read Modelica file {p}: {err.strerror or err}") from None
     except UnicodeDecodeError as err:
-        raise ModelicaError(f"Modelica file {p} is not UTF-8 text ({err.reason} at byte "
-                            f"{err.start})") from None
+        line = data.count(b"\n", 0, err.start) + 1
+        col = err.start - data.rfind(b"\n", 0, err.start)
+        raise ModelicaSyntaxError(str(path), line, col, f"the file is not UTF-8 text "
+                                  f"({err.reason}: byte 0x{data[err.start]:02x})") from None
     key = str(p.resolve())
     stamp = (st.st_mtime_ns, st.st_size, hash(data), str(path))
     hit = _CACHE.get(key)

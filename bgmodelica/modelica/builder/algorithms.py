@@ -20,6 +20,7 @@ from .. import ast as A
 from .. import scope as S
 from .arith import _if_else
 from .base import Ctx, NotConstant, fail, numeric_value
+from .types import check_condition
 
 #: statements run per call before a loop is taken for endless
 MAX_STEPS = 300_000
@@ -241,6 +242,7 @@ def _run(stmts: tuple, ctx: Ctx, state: _State) -> None:
         elif t is A.StmtFor:
             _for(st, ctx, state)
         elif t is A.StmtWhile:
+            check_condition(st.condition, ctx, "a while-loop")
             while True:
                 c = _known(evaluate(st.condition, ctx), ctx)
                 if _symbolic(c):
@@ -274,6 +276,7 @@ def _if(st: A.StmtIf, ctx: Ctx, state: _State) -> None:
     from .evaluate import evaluate
 
     for k, (cond, body) in enumerate(st.branches):
+        check_condition(cond, ctx, "an if-statement")
         c = _known(evaluate(cond, ctx), ctx)
         if not _symbolic(c):
             if c:

@@ -16,7 +16,7 @@ from ...core.variables import (
 )
 from .. import ast as A
 from .. import scope as S
-from ..errors import ModelicaError
+from ..errors import ModelicaError, internal_text
 
 if TYPE_CHECKING:
     from .env import Env
@@ -47,6 +47,33 @@ def _where(lex: S.ClassScope | None, pos: A.Pos) -> str:
     if lex is None:
         return "<modifier>"
     return f"{lex.cdef.file or lex.file.file}:{pos[0]}:{pos[1]}"
+
+
+#: the most elements an array (a declaration, fill()/zeros()/ones(), a range) may have: the
+#: builder makes a Python object per element, so a larger array would exhaust time and memory
+#: before any message; it is refused when its size is known, before anything is allocated
+MAX_ARRAY_ELEMENTS = 10**6
+
+
+def check_array_size(count: int, lex: S.ClassScope | None, node: Any, what: str) -> None:
+    """Refuse an array of more than :data:`MAX_ARRAY_ELEMENTS` elements."""
+    if count > MAX_ARRAY_ELEMENTS:
+        raise fail(lex, node, f"array too large: {what} would have {count:,} elements (the "
+                   f"limit is {MAX_ARRAY_ELEMENTS:,})")
+
+
+#: exceptions of Python, CasADi or the builder itself that a construct the builder does not
+#: handle can raise; where the construct is known they become a :class:`ModelicaError` with
+#: its position (a traceback is never the answer to a Modelica text)
+INTERNAL_ERRORS = (RecursionError, KeyError, IndexError, TypeError, ValueError,
+                   AttributeError, ZeroDivisionError, OverflowError, RuntimeError)
+
+
+def describe_internal(err: BaseException) -> str:
+    """One line for an internal exception: what failed, in the builder's words."""
+    if isinstance(err, NotConstant):
+        return f"a value is not known when the model is built: {err.what}"
+    return internal_text(err)
 
 
 def fail(lex: S.ClassScope | None, node: Any, message: str) -> ModelicaError:

@@ -101,6 +101,7 @@ def class_view(scope: S.ClassScope, _stack: tuple = ()) -> ClassView:
             bview = class_view(base, _stack + (scope,))
             _inherit(view, bview, mod_from_ast(el.mod, SELF, scope))
         elif isinstance(el, A.Component):
+            _check_new_name(scope, el, view)
             view.elements[el.name] = ElemInfo(el, scope, mod_from_ast(el.mod, SELF, scope))
     for eq in cdef.equations:
         view.equations.append((eq, scope))
@@ -114,6 +115,28 @@ def class_view(scope: S.ClassScope, _stack: tuple = ()) -> ClassView:
     _discrete_by_when(view)
     scope._view = view
     return view
+
+
+def _check_new_name(scope: S.ClassScope, el: A.Component, view: ClassView) -> None:
+    """A component declared twice in one class, or named like a class declared there, is an
+    error (specification 5.6.1); an inherited element of that name is redeclared only if
+    the declarations are identical, which bgmodelica does not compare: the local one wins."""
+    first = view.elements.get(el.name)
+    if first is not None and first.lex is scope:
+        raise fail(scope, el, f"component {el.name} is declared twice in {scope.cdef.name} "
+                   f"(first at line {first.comp.pos[0]})")
+    if any(isinstance(c, A.ClassDef) and c.name == el.name for c in scope.cdef.elements):
+        raise fail(scope, el, f"component {el.name} has the name of a class declared in "
+                   f"{scope.cdef.name}")
+
+
+def check_not_final(info: ElemInfo, m: Mod) -> None:
+    """A modifier (or redeclaration) of an element declared ``final`` is an error
+    (specification 7.2.6)."""
+    if "final" in info.comp.element_prefixes and (m.has_binding or m.sub or m.redeclare):
+        raise fail(m.lex or info.lex, m.pos if m.pos != (0, 0) else info.comp,
+                   f"{info.comp.name} is declared final (line {info.comp.pos[0]}) and cannot "
+                   "be modified")
 
 
 def constraining_mod(info: ElemInfo) -> Any:
@@ -213,6 +236,7 @@ def _inherit(view: ClassView, base: ClassView, ext_mod: Mod | None) -> None:
             if name not in base.elements:
                 raise fail(m.lex, m.pos, f"extends {base.scope.full_name}: the base class has "
                            f"no element {name!r} to modify")
+            check_not_final(base.elements[name], m)
     view.equations.extend(base.equations)
     view.initial.extend(base.initial)
     view.unsupported.extend(base.unsupported)
@@ -304,8 +328,9 @@ def find_class(file: S.FileScope, name: str) -> S.ClassScope:
             head, S.Builtin) else None
     if not isinstance(got, S.ClassScope):
         models = list_models(file)
-        raise ModelicaError(f"{file.file}: no class {name!r}; it defines: "
-                            f"{', '.join(models) or 'no models'}")
+        raise ModelicaError(f"{file.file}:1:1: no class {name!r}; it defines: "
+                            f"{', '.join(models) or 'no models'}"
+                            + ("" if file.classes else " (the file declares no class)"))
     return got
 
 

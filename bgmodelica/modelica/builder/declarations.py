@@ -4,9 +4,12 @@ variables and parameters.
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 from ...core.component import Element
+from ...core.units import UnitParseError
+from ...core.units import parse as parse_unit
 from ...core.variables import (
     KIND_PARAMETER,
     Boolean,
@@ -50,6 +53,22 @@ def _attr_values(m: Mod | None, numeric_ctx: bool, lex: Any, comp: A.Component) 
     return out
 
 
+#: unit names of the Modelica Standard Library outside the SI that the unit registry does
+#: not define (reactive power, Rankine, loudness): accepted, as a tool may
+_NON_SI = re.compile(r"^[A-Za-z]*(var|degRk|phon|sone)$")
+
+
+def _check_unit(unit: str, lex: Any, comp: A.Component) -> None:
+    """A unit string that is not a unit is an error (specification 19.1), named at the
+    declaration."""
+    try:
+        parse_unit(unit)
+    except UnitParseError as err:
+        if all(_NON_SI.match(w) for w in re.findall(r"[A-Za-z]+", unit)):
+            return
+        raise fail(lex, comp, f"{comp.name}: {err}") from None
+
+
 def _make_decl(info: ElemInfo, tref: TypeRef, attrs: dict, value: Any, connector: bool,
                lex: Any) -> Any:
     comp = info.comp
@@ -60,6 +79,8 @@ def _make_decl(info: ElemInfo, tref: TypeRef, attrs: dict, value: Any, connector
         raise fail(lex, comp, f"{comp.name}: unit must be a string")
     if tref.base != "Real":
         unit = ""
+    elif unit:
+        _check_unit(unit, lex, comp)
     kw: dict[str, Any] = {"unit": unit, "description": desc}
     for k in ("min", "max"):
         if k in attrs and attrs[k] is not None:
@@ -233,8 +254,10 @@ def _override(decl: Any, m: Mod, info: ElemInfo, tref: TypeRef) -> Any:
         elif _is_number(value):
             value = float(value)
         elif isinstance(value, (list, Element, str)):
-            raise fail(m.lex or info.lex, m.pos, f"parameter {comp.name} is bound to "
-                       f"{type(value).__name__} {value!r}")
+            what = {"str": "the String", "list": "the array"}.get(type(value).__name__,
+                                                                   "the component")
+            raise fail(m.lex or info.lex, m.pos, f"parameter {comp.name} is a number and "
+                       f"cannot be given {what} {value!r}")
         changes["value"] = value
     if m.sub:
         attrs = _attr_values(m, True, info.lex, comp)

@@ -4,12 +4,13 @@ equations and modifiers, and array sizes.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 from ...core.component import Element
 from .. import ast as A
 from .. import scope as S
-from .base import Ctx, NotConstant, fail, numeric_value
+from .base import Ctx, NotConstant, check_array_size, fail, numeric_value
 from .classes import ClassView, ElemInfo, TypeRef, class_view, type_ref
 from .mods import Mod, bind, merge
 
@@ -128,6 +129,7 @@ def _dims(info: ElemInfo, env: Env | None, numeric: bool = True) -> tuple[int, .
                            f"Integer, got {v!r}")
             size = int(v)
         out.append(size)
+    check_array_size(math.prod(out), info.lex, info.comp, info.comp.name)
     return tuple(out)
 
 

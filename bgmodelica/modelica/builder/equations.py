@@ -13,9 +13,19 @@ from ...errors import ConnectError, DeclarationError, EquationError, ModelError
 from .. import ast as A
 from .. import scope as S
 from ..errors import ModelicaError
-from .base import Ctx, NotConstant, _Disabled, _is_number, fail, numeric_value
+from .base import (
+    INTERNAL_ERRORS,
+    Ctx,
+    NotConstant,
+    _Disabled,
+    _is_number,
+    describe_internal,
+    fail,
+    numeric_value,
+)
 from .env import Env
 from .evaluate import _iterate, evaluate
+from .types import check_condition
 
 
 def _equation(a: Any, b: Any, ctx: Ctx, node: Any, out: list) -> None:
@@ -92,6 +102,12 @@ def _eval_equation(eq: Any, ctx: Ctx, out: list, initial: bool) -> None:
         if isinstance(err, ModelicaError):
             raise
         raise fail(ctx.lex, eq, str(err)) from None
+    except NotConstant as err:
+        raise fail(ctx.lex, eq, f"cannot evaluate when the model is built: {err.what}") \
+            from None
+    except INTERNAL_ERRORS as err:
+        raise fail(ctx.lex, eq, f"cannot build this equation: {describe_internal(err)}") \
+            from None
 
 
 #: the time at which initial equations of discrete variables are evaluated when the model is
@@ -316,6 +332,7 @@ def _own_output(x: Any, ctx: Ctx) -> bool | None:
 def _eval_if_equation(eq: A.EqIf, ctx: Ctx, out: list, initial: bool) -> None:
     symbolic = []
     for cond, body in eq.branches:
+        check_condition(cond, ctx, "an if-equation")
         try:
             c = numeric_value(evaluate(cond, Ctx(ctx.env, ctx.lex, ctx.loops, True)), ctx.lex,
                               cond)

@@ -19,9 +19,10 @@ from .arith import (
     _neg,
     _relation,
 )
-from .base import Ctx, NotConstant, _Disabled, fail, numeric_value
-from .classes import type_ref
+from .base import Ctx, NotConstant, _Disabled, check_array_size, fail, numeric_value
+from .classes import class_view, type_ref
 from .env import Env, _category, static_env
+from .types import check_condition, check_number_operands
 
 
 def evaluate(node: Any, ctx: Ctx) -> Any:
@@ -58,6 +59,7 @@ def _ev_ref(node: A.Ref, ctx: Ctx) -> Any:
                 val = _subscript(val, subs, ctx, node)
             for name, subs in parts[1:]:
                 if isinstance(val, Element):
+                    _check_public(val, name, ctx, node)
                     val = member(val, name, False, ctx.lex, node)
                 elif isinstance(val, list):
                     val = _map_member(val, name, ctx, node)
@@ -79,6 +81,9 @@ def _ev_ref(node: A.Ref, ctx: Ctx) -> Any:
         val = _lexical_value(found, ctx, node)
     elif env is not None and name in env.view.elements and len(parts) > 1 \
             and _unbuilt_child(env, name) and _child_parameter(env, name, parts[1:]):
+        tref = type_ref(env.view.elements[name])
+        if tref.kind == "class" and tref.scope is not None:
+            _check_public_in(class_view(tref.scope), parts[1][0], name, ctx.lex, node)
         return _child_parameter(env, name, parts[1:])[0]
     elif env is not None and name in env.view.elements:
         val = _env_member(env, name, ctx, node)
@@ -109,6 +114,7 @@ def _ev_ref(node: A.Ref, ctx: Ctx) -> Any:
         val = _subscript(val, subs, ctx, node)
     for name, subs in parts[rest:]:
         if isinstance(val, Element):
+            _check_public(val, name, ctx, node)
             val = member(val, name, ctx.numeric, ctx.lex, node)
         elif isinstance(val, list):
             val = _map_member(val, name, ctx, node)
@@ -152,8 +158,27 @@ def _child_parameter(env: Env, name: str, rest: tuple) -> tuple | None:
 
 
 def _map_member(val: list, name: str, ctx: Ctx, node: Any) -> list:
+    for v in val[:1]:
+        if isinstance(v, Element):
+            _check_public(v, name, ctx, node)
     return [(_map_member(v, name, ctx, node) if isinstance(v, list)
              else member(v, name, ctx.numeric, ctx.lex, node)) for v in val]
+
+
+def _check_public(elem: Element, name: str, ctx: Ctx, node: Any) -> None:
+    """``a.name`` is refused when ``name`` is a protected element of ``a``'s class
+    (specification 4.1: protected elements are not accessible by dot notation)."""
+    env = elem.__dict__.get("_mo_env")
+    if env is not None:
+        _check_public_in(env.view, name, elem.name, ctx.lex, node)
+
+
+def _check_public_in(view: Any, name: str, owner: str, lex: Any, node: Any) -> None:
+    info = view.elements.get(name)
+    if info is not None and name in info.lex.cdef.protected:
+        raise fail(lex, node if node is not None else (0, 0),
+                   f"{owner}.{name}: {name} is a protected element of {view.cdef.name} "
+                   "(protected elements cannot be read from outside their class)")
 
 
 def _is_value(found: Any) -> bool:
@@ -324,6 +349,7 @@ def _ev_binop(node: A.BinOp, ctx: Ctx) -> Any:
     b = evaluate(node.b, ctx)
     if op in ("<", "<=", ">", ">=", "==", "<>"):
         return _relation(op, a, b, ctx, node)
+    check_number_operands(node, ctx)
     return _arith(op, a, b, ctx, node)
 
 
@@ -337,12 +363,14 @@ def _ev_unary(node: A.Unary, ctx: Ctx) -> Any:
         return not a
     if node.op == "+":
         return a
+    check_number_operands(node, ctx)
     return _neg(a, ctx, node)
 
 
 def _ev_if(node: A.IfExpr, ctx: Ctx) -> Any:
     conds = []
     for cond, val in node.branches:
+        check_condition(cond, ctx, "an if-expression")
         c = evaluate(cond, ctx)
         if isinstance(c, (bool, int, float)) and not isinstance(c, Expr):
             if c:
@@ -370,10 +398,13 @@ def _ev_range(node: A.Range, ctx: Ctx) -> Any:
     if all(isinstance(v, int) and not isinstance(v, bool) for v in (start, stop, step)):
         if step == 0:
             raise fail(ctx.lex, node, "range step is zero")
-        return list(range(start, stop + (1 if step > 0 else -1), step))
+        out = range(start, stop + (1 if step > 0 else -1), step)
+        check_array_size(len(out), ctx.lex, node, "the range")
+        return list(out)
     if step == 0:
         raise fail(ctx.lex, node, "range step is zero")
     n = int(math.floor((stop - start) / step + 1e-12)) + 1
+    check_array_size(n, ctx.lex, node, "the range")
     return [start + k * step for k in range(max(n, 0))]
 
 

@@ -14,8 +14,9 @@ from ...errors import ModelError
 from .. import ast as A
 from .. import scope as S
 from .arith import _flatten, _num_or_expr, _shape, _sum
-from .base import Ctx, NotConstant, fail, numeric_value
+from .base import Ctx, NotConstant, check_array_size, fail, numeric_value
 from .evaluate import _comprehension, evaluate
+from .types import check_der_argument
 
 
 def _ev_call(node: A.Call, ctx: Ctx) -> Any:
@@ -146,6 +147,7 @@ def _symbolic(ctx: Ctx, node: Any, name: str) -> None:
 
 def _fn_der(node: A.Call, ctx: Ctx) -> Any:
     _symbolic(ctx, node, "der")
+    check_der_argument(node, ctx)
     (x,) = _args(node, ctx, 1, "der")
     try:
         return _elementwise(X.der)(x)
@@ -336,6 +338,7 @@ def _sizes(node: A.Call, ctx: Ctx, name: str, first: int = 0) -> tuple[list, lis
         if isinstance(v, bool) or not isinstance(v, (int, float)) or v != int(v) or v < 0:
             raise fail(ctx.lex, node, f"{name}(): sizes must be non-negative Integers")
         dims.append(int(v))
+    check_array_size(math.prod(dims), ctx.lex, node, f"{name}()")
     return vals, dims
 
 

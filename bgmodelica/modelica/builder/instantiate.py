@@ -20,6 +20,7 @@ from .classes import (
     ClassView,
     ElemInfo,
     TypeRef,
+    check_not_final,
     class_view,
     constraining_mod,
     resolve_class,
@@ -63,6 +64,7 @@ def instantiate(view: ClassView, mods: dict[str, Mod], parent: Env | None, path:
             raise fail(m.lex or where, m.pos if m.pos != (0, 0) else pos,
                        f"{view.scope.full_name} has no element {name!r} to modify; it has: "
                        f"{', '.join(view.elements) or 'none'}")
+        check_not_final(view.elements[name], mods[name])
     plan = view.plan
     if plan is not None and not any(m.redeclare is not None for m in mods.values()):
         arrays, scalars, children, cls = plan
@@ -278,6 +280,16 @@ def _make_class(view: ClassView, decls: dict[str, Any], connector: bool) -> type
         raise fail(view.scope, view.cdef, str(err)) from None
 
 
+def _check_not_recursive(tref: TypeRef, env: Env, info: ElemInfo) -> None:
+    """A component of a class that encloses it (``model M  M m; end M;``) would be infinite."""
+    e: Env | None = env
+    while e is not None:
+        if e.view.scope is tref.scope:
+            raise fail(info.lex, info.comp, f"component {info.comp.name} is recursive: its "
+                       f"class {tref.scope.full_name} contains it")
+        e = e.parent
+
+
 def _make_child(tref: TypeRef, m: Mod | None, env: Env, path: str, info: ElemInfo) -> Element:
     if m is not None and m.has_binding:
         raise fail(m.lex or info.lex, m.pos, f"{info.comp.name}: a component cannot be bound "
@@ -286,6 +298,7 @@ def _make_child(tref: TypeRef, m: Mod | None, env: Env, path: str, info: ElemInf
         view = class_view(tref.scope)
         if view.kind == "package":
             raise fail(info.lex, info.comp, f"{tref.name} is a package, not a type")
+        _check_not_recursive(tref, env, info)
         return instantiate(view, dict(m.sub) if m is not None else {}, env, path, info.lex,
                            info.comp.pos)
     if tref.kind == "msl":
@@ -341,6 +354,29 @@ def _make_msl(msl: S.MslClass, m: Mod | None, path: str, info: ElemInfo) -> Elem
     return inst
 
 
+_EXPERIMENT = ("StartTime", "StopTime", "Interval", "Tolerance")
+
+
+def _experiment_value(sub: A.ElementMod, scope: S.ClassScope) -> float | None:
+    """The number of one ``experiment`` setting (None for settings of other tools); a value
+    of a standard setting that is not a number is an error."""
+    try:
+        v = numeric_value(evaluate(sub.mod.binding, Ctx(None, scope, {}, True)))
+    except NotConstant:
+        v = None
+    except ModelicaError:
+        if sub.name in _EXPERIMENT:
+            raise
+        return None
+    if isinstance(v, (int, float)) and not isinstance(v, bool):
+        return float(v)
+    if sub.name in _EXPERIMENT:
+        raise fail(scope, sub.mod.binding, f"experiment {sub.name} must be a number, got "
+                   + (repr(v) if v is not None else "an expression not known before "
+                      "simulation"))
+    return None
+
+
 def experiment(scope: S.ClassScope) -> dict[str, float]:
     """``annotation(experiment(StartTime=, StopTime=, Interval=, Tolerance=))`` of a class
     (inherited through ``extends``)."""
@@ -352,13 +388,9 @@ def experiment(scope: S.ClassScope) -> dict[str, float]:
                 for sub in arg.mod.args:
                     if isinstance(sub, A.ElementMod) and sub.mod is not None \
                             and sub.mod.binding is not None:
-                        try:
-                            v = numeric_value(evaluate(sub.mod.binding,
-                                                       Ctx(None, scope, {}, True)))
-                        except (NotConstant, ModelicaError):
-                            continue
-                        if isinstance(v, (int, float)) and not isinstance(v, bool):
-                            out[sub.name] = float(v)
+                        v = _experiment_value(sub, scope)
+                        if v is not None:
+                            out[sub.name] = v
     if not out:
         for el in cdef.elements:
             if isinstance(el, A.Extends):

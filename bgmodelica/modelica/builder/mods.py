@@ -108,6 +108,10 @@ def merge(outer: Mod | None, inner: Mod | None) -> Mod | None:
         return inner
     if inner is None:
         return outer
+    if inner.final and outer.has_binding and inner.has_binding and outer is not inner:
+        raise fail(outer.lex or inner.lex, outer.pos if outer.pos != (0, 0) else inner.pos,
+                   f"the value is fixed by a final modifier (line {inner.pos[0]}) and cannot "
+                   "be modified")
     base = outer if outer.has_binding else inner
     m = Mod(base.binding, base.scope, base.lex, base.each, None,
             outer.redeclare or inner.redeclare, base.pos, base.const, inner.final or outer.final)

@@ -1,0 +1,6 @@
+// expect: 5 unexpected
+model M
+  Real x;
+equation
+  x = 1 +* 2;
+end M;
