@@ -267,8 +267,17 @@ def _subscript(val: Any, subs: tuple, ctx: Ctx, node: Any) -> Any:
         if isinstance(s, A.Colon):
             idx.append(None)
             continue
-        v = evaluate(s, Ctx(ctx.env, ctx.lex, ctx.loops, True))
-        v = numeric_value(v, ctx.lex, s)
+        try:
+            v = evaluate(s, Ctx(ctx.env, ctx.lex, ctx.loops, True))
+            v = numeric_value(v, ctx.lex, s)
+        except NotConstant:
+            if ctx.numeric:
+                raise
+            v = evaluate(s, ctx)        # a time-varying Integer index
+            if isinstance(v, Expr):
+                idx.append(v)
+                continue
+            v = numeric_value(v, ctx.lex, s)
         if isinstance(v, S.EnumValue):
             v = v.index
         if isinstance(v, list):
@@ -289,9 +298,25 @@ def _subscript(val: Any, subs: tuple, ctx: Ctx, node: Any) -> Any:
             return [apply(x, k + 1) for x in v]
         if isinstance(i, list):
             return [apply(_at(v, j, ctx, node), k + 1) for j in i]
+        if isinstance(i, Expr):
+            return _select(i, [apply(x, k + 1) for x in v], ctx, node)
         return apply(_at(v, i, ctx, node), k + 1)
 
     return apply(val, 0)
+
+
+def _select(i: Expr, items: list, ctx: Ctx, node: Any) -> Any:
+    """``items[i]`` for a time-varying Integer ``i``: ``if i == 1 then items[1] elseif ...``
+    (an index out of range takes the last element)."""
+    if not items:
+        raise fail(ctx.lex, node, f"index into the empty array {getattr(node, 'dotted', '')}")
+    if any(isinstance(x, Element) for x in _flatten(items)):
+        raise fail(ctx.lex, node, f"{getattr(node, 'dotted', 'expression')}: a component "
+                   "selected by a time-varying index")
+    out = items[-1]
+    for k in range(len(items) - 1, 0, -1):
+        out = _if_else(_relation("==", i, k, ctx, node), items[k - 1], out, ctx, node)
+    return out
 
 
 def _at(v: list, i: int, ctx: Ctx, node: Any) -> Any:
