@@ -63,6 +63,9 @@ def _instantiate(scope: Any, name: str, where: str, kwargs: dict[str, Any]):
                             "recursive") from None
     except ModelError:
         raise
+    except B.NotConstant as err:
+        raise ModelicaError(f"{where}: {name}: cannot evaluate when built: {err.what}") \
+            from None
     exp = B.experiment(scope)
     object.__setattr__(model, "_mo_experiment", exp)
     if "experiment" not in model._symbols and "experiment" not in model._children:

@@ -20,8 +20,10 @@ if-equations on parameters, conditional components) are evaluated when the model
 
 from __future__ import annotations
 
+from .base import NotConstant
 from .classes import class_view, find_class, list_models
 from .instantiate import experiment, instantiate
 from .mods import top_mods
 
-__all__ = ["class_view", "experiment", "find_class", "instantiate", "list_models", "top_mods"]
+__all__ = ["NotConstant", "class_view", "experiment", "find_class", "instantiate", "list_models",
+           "top_mods"]

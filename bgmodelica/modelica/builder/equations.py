@@ -92,6 +92,8 @@ def _eval_equation(eq: Any, ctx: Ctx, out: list, initial: bool) -> None:
         if isinstance(err, ModelicaError):
             raise
         raise fail(ctx.lex, eq, str(err)) from None
+    except NotConstant as err:
+        raise fail(ctx.lex, eq, f"cannot evaluate: {err.what}") from None
 
 
 #: the time at which initial equations of discrete variables are evaluated when the model is
