@@ -559,7 +559,7 @@ def section_equations(stmts: A.Statements, ctx: Ctx, out: list, initial: bool) -
     leaves = {n: evaluate(A.Ref(((n, None),), stmts.pos), ctx) for n in names}
     local = dict(ctx.loops)
     for n in names:
-        local[n] = _pre(leaves[n]) if not initial else None
+        local[n] = _pre(leaves[n]) if not initial else _unset(leaves[n])
     state = _State()
     state.whens = []
     state.leaves = leaves
@@ -574,7 +574,7 @@ def section_equations(stmts: A.Statements, ctx: Ctx, out: list, initial: bool) -
     for n in names:
         if n in in_when:
             continue
-        if local.get(n) is None:
+        if _has_unset(local.get(n)):
             raise fail(ctx.lex, stmts, f"{n} is not assigned on every path of the algorithm")
         if initial and (_discrete_start(leaves[n], local[n], ctx, stmts)
                         or _parameter_value(leaves[n], local[n], ctx, stmts)):
@@ -582,6 +582,15 @@ def section_equations(stmts: A.Statements, ctx: Ctx, out: list, initial: bool) -
         _equation(leaves[n], local[n], ctx, stmts, out)
     for branches in state.whens:
         out.append(_when_of(branches, leaves, ctx, stmts))
+
+
+def _unset(v: Any) -> Any:
+    """``v``'s shape with no value yet (an initial algorithm assigns it)."""
+    return [_unset(x) for x in v] if isinstance(v, list) else None
+
+
+def _has_unset(v: Any) -> bool:
+    return any(_has_unset(x) for x in v) if isinstance(v, list) else v is None
 
 
 def _when_of(branches: list, leaves: dict, ctx: Ctx, node: Any) -> Any:

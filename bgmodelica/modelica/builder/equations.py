@@ -102,9 +102,10 @@ INITIAL_TIME = 0.0
 
 
 def _discrete_start(a: Any, b: Any, ctx: Ctx, node: Any) -> bool:
-    """An initial equation ``d = value`` of a discrete variable whose value is known when
-    the model is built sets its start value (its value before the first event)."""
-    from ...core.variables import KIND_DISCRETE
+    """An initial equation ``d = value`` of a discrete variable (or an Integer, Boolean or
+    enumeration output) whose value is known when the model is built sets its start value
+    (its value before the first event)."""
+    from ...core.variables import KIND_DISCRETE, KIND_OUTPUT
 
     if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
         if all(_discrete_start(x, y, ctx, node) for x, y in zip(a, b, strict=True)):
@@ -112,7 +113,8 @@ def _discrete_start(a: Any, b: Any, ctx: Ctx, node: Any) -> bool:
         return False
     sym = getattr(a, "sym", None) if isinstance(a, Expr) else None
     decl = getattr(sym, "decl", None)
-    if decl is None or decl.kind != KIND_DISCRETE:
+    if decl is None or not (decl.kind == KIND_DISCRETE or decl.kind == KIND_OUTPUT
+                            and getattr(decl, "type_name", "Real") != "Real"):
         return False
     try:
         # at initialization time is the start time, 0 in the examples of the libraries
