@@ -556,7 +556,8 @@ def section_equations(stmts: A.Statements, ctx: Ctx, out: list, initial: bool) -
     from .evaluate import evaluate
 
     names = _targets(stmts)
-    leaves = {n: evaluate(A.Ref(((n, None),), stmts.pos), ctx) for n in names}
+    leaves = {n: _leaf(n, ctx, stmts) if initial else evaluate(A.Ref(((n, None),), stmts.pos),
+                                                                ctx) for n in names}
     local = dict(ctx.loops)
     for n in names:
         local[n] = _pre(leaves[n]) if not initial else _unset(leaves[n])
@@ -582,6 +583,19 @@ def section_equations(stmts: A.Statements, ctx: Ctx, out: list, initial: bool) -
         _equation(leaves[n], local[n], ctx, stmts, out)
     for branches in state.whens:
         out.append(_when_of(branches, leaves, ctx, stmts))
+
+
+def _leaf(name: str, ctx: Ctx, node: Any) -> Any:
+    """The variable ``name`` an initial algorithm assigns: a parameter (also a Boolean or
+    Integer one, otherwise a value when built) as its symbol."""
+    from .evaluate import evaluate, member
+
+    env = ctx.env
+    inst = env.inst if env is not None else None
+    if inst is not None and (name in inst._symbols or name in (
+            inst.__dict__.get("_mo_arrays") or ())):
+        return member(inst, name, False, ctx.lex, node)
+    return evaluate(A.Ref(((name, None),), node.pos), ctx)
 
 
 def _unset(v: Any) -> Any:

@@ -66,6 +66,8 @@ class Env:
             m = self.emod(name)
             if m is not None and m.has_binding:
                 value = m.value(True)
+            elif category == "param" and self._solved_initially(name, m):
+                return self._num[name]
             elif m is not None and "start" in m.sub and m.sub["start"].has_binding:
                 value = m.sub["start"].value(True)
             else:
@@ -77,6 +79,25 @@ class Env:
             self._busy.discard(name)
         self._num[name] = value
         return value
+
+
+    def _solved_initially(self, name: str, m: Mod | None) -> bool:
+        """Whether parameter ``name``, declared ``fixed = false``, took its value from the
+        initial equations and algorithms of the instance (run now when they can be)."""
+        fixed = m.sub.get("fixed") if m is not None else None
+        if fixed is None or not fixed.has_binding or fixed.value(True) is not False \
+                or self.inst is None or not self.view.initial \
+                or f"{name} (initial)" in self._busy:
+            return False
+        from .equations import equations_of
+
+        self._busy.discard(name)
+        self._busy.add(f"{name} (initial)")
+        try:
+            equations_of(self, self.view.initial, initial=True)
+        finally:
+            self._busy.discard(f"{name} (initial)")
+        return name in self._num
 
 
 def _default_value(tref: TypeRef) -> Any:

@@ -159,9 +159,9 @@ def _parameter_value(a: Any, b: Any, ctx: Ctx, node: Any) -> bool:
             value = value.index
         if not isinstance(value, (bool, int, float)):
             return False
-        solved.append((sym, decl, float(value)))
+        solved.append((sym, decl, value))
     for sym, decl, value in solved:
-        sym.decl = decl.evolve(value=value)
+        sym.decl = decl.evolve(value=float(value))
         _remember(sym, value)
     return bool(solved)
 
