@@ -243,9 +243,10 @@ def _connect(a: Any, b: Any, ctx: Ctx, node: Any, out: list) -> None:
             _connect(x, y, ctx, node, out)
         return
     own = _own_output(a, ctx), _own_output(b, ctx)
-    if own[0] is not None and own[1] is not None and own[0] != own[1]:
-        # an inside output connected to this block's own output (an outside connector):
-        # the outside one takes the inside one's value
+    if own[0] is not None and own[1] is not None and (own[0] or own[1]):
+        # an inside output connected to this block's own output (an outside connector), or
+        # two own outputs (specification 9.3: outside outputs are not sources): the outside
+        # one takes the other's value
         outer, inner = (a, b) if own[0] else (b, a)
         out.append(Equation(outer, inner))
         return
