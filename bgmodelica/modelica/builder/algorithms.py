@@ -12,7 +12,6 @@ C name (:mod:`bgmodelica.modelica.externals`).
 
 from __future__ import annotations
 
-import copy
 from typing import Any
 
 from ...core.expr import Expr
@@ -192,15 +191,17 @@ def _initial(comp: A.Component, lex: S.ClassScope, local: dict, info: Any) -> An
     zero: Any = "" if comp.type_name == "String" else (
         False if comp.type_name == "Boolean" else 0)
     for n in reversed(dims):
-        zero = [copy.deepcopy(zero) for _ in range(n)]
+        zero = [_lists(zero) for _ in range(n)]
     return zero
 
 
 class _State:
-    __slots__ = ("steps", "whens", "leaves", "guard")
+    __slots__ = ("steps", "whens", "leaves", "guard", "branching")
 
     def __init__(self) -> None:
         self.steps = 0
+        #: inside branches of an ``if`` on a time-varying condition (run both)
+        self.branching = 0
         #: True, or the time-varying condition under which no ``return`` has happened yet
         #: (assignments then keep the returned value where it is false)
         self.guard: Any = True
@@ -257,7 +258,7 @@ def _run(stmts: tuple, ctx: Ctx, state: _State) -> None:
                     raise fail(ctx.lex, st, f"while loop did not finish after {MAX_STEPS} "
                                "statements")
         elif t is A.StmtCall:
-            _call_statement(st, ctx)
+            _call_statement(st, ctx, state)
         elif t is A.Return:
             raise _Return()
         elif t is A.Break:
@@ -283,10 +284,11 @@ def _if(st: A.StmtIf, ctx: Ctx, state: _State) -> None:
         # a symbolic condition: both sides, merged
         rest = A.StmtIf(st.branches[k + 1:], st.otherwise, st.pos) if st.branches[k + 1:] \
             else None
-        then_vals = {n: copy.copy(v) for n, v in ctx.loops.items()}
-        else_vals = {n: copy.copy(v) for n, v in ctx.loops.items()}
+        then_vals = {n: _lists(v) for n, v in ctx.loops.items()}
+        else_vals = {n: _lists(v) for n, v in ctx.loops.items()}
         g0 = state.guard
         then_done = else_done = False
+        state.branching += 1
         try:
             _run(body, Ctx(ctx.env, ctx.lex, then_vals, False), state)
         except _Return:
@@ -294,7 +296,10 @@ def _if(st: A.StmtIf, ctx: Ctx, state: _State) -> None:
         except _Break:
             raise fail(ctx.lex, st, "break under a time-varying condition (not supported)") \
                 from None
+        finally:
+            state.branching -= 1
         g_then, state.guard = state.guard, g0
+        state.branching += 1
         try:
             if rest is not None:
                 _if(rest, Ctx(ctx.env, ctx.lex, else_vals, False), state)
@@ -305,6 +310,8 @@ def _if(st: A.StmtIf, ctx: Ctx, state: _State) -> None:
         except _Break:
             raise fail(ctx.lex, st, "break under a time-varying condition (not supported)") \
                 from None
+        finally:
+            state.branching -= 1
         g_else = state.guard
         for name in set(then_vals) | set(else_vals):
             a, b = then_vals.get(name), else_vals.get(name)
@@ -321,6 +328,12 @@ def _if(st: A.StmtIf, ctx: Ctx, state: _State) -> None:
                               ctx, st)
         return
     _run(st.otherwise, ctx, state)
+
+
+def _lists(v: Any) -> Any:
+    """A copy of the (nested) lists of ``v``; the values in them are shared (expressions
+    are immutable, and copying them would copy whole expression graphs)."""
+    return [_lists(x) for x in v] if isinstance(v, list) else v
 
 
 def _select(c: Any, a: Any, b: Any, ctx: Ctx, node: Any) -> Any:
@@ -418,7 +431,7 @@ def _store(ref: Any, value: Any, ctx: Ctx, node: Any) -> None:
         raise fail(ctx.lex, node, f"assignment to {name!r}, which is not a variable of the "
                    "function")
     if not subs:
-        ctx.loops[name] = copy.deepcopy(value) if isinstance(value, list) else value
+        ctx.loops[name] = _lists(value)
         return
     cur = ctx.loops[name]
     num = Ctx(ctx.env, ctx.lex, ctx.loops, False)
@@ -428,7 +441,7 @@ def _store(ref: Any, value: Any, ctx: Ctx, node: Any) -> None:
             idx.append(None)
             continue
         v = _known(evaluate(s, num), ctx)
-        if _symbolic(v):
+        if isinstance(v, list) and _symbolic(v):
             raise fail(ctx.lex, node, f"subscript of {name} depends on time-varying values")
         idx.append(v)
     ctx.loops[name] = _set(cur, idx, value, ctx, node, name)
@@ -441,6 +454,13 @@ def _set(cur: Any, idx: list, value: Any, ctx: Ctx, node: Any, name: str) -> Any
         raise fail(ctx.lex, node, f"{name}: too many subscripts")
     head, rest = idx[0], idx[1:]
     cur = list(cur)
+    if isinstance(head, Expr):
+        # a time-varying index: each element keeps its value unless the index names it
+        from .arith import _relation
+
+        return [_merge(_relation("==", head, p + 1, ctx, node),
+                       _set(x, rest, value, ctx, node, name), x, ctx, node)
+                for p, x in enumerate(cur)]
     if head is None:
         positions = list(range(len(cur)))
         vals = value if isinstance(value, list) else [value] * len(cur)
@@ -459,14 +479,14 @@ def _set(cur: Any, idx: list, value: Any, ctx: Ctx, node: Any, name: str) -> Any
     return cur
 
 
-def _call_statement(st: A.StmtCall, ctx: Ctx) -> None:
+def _call_statement(st: A.StmtCall, ctx: Ctx, state: _State) -> None:
     from .evaluate import evaluate
 
     call = st.call
     name = call.func.dotted
     if name == "assert":
         cond = evaluate(call.args[0], ctx)
-        if _symbolic(cond):
+        if _symbolic(cond) or state.branching:
             return                  # checked while simulating only for model equations
         if not cond:
             msg = evaluate(call.args[1], ctx) if len(call.args) > 1 else "assertion failed"
@@ -532,6 +552,10 @@ def _external(fn: FunctionDef, local: dict, ctx: Ctx, node: Any) -> None:
     except NotConstant:
         raise
     except Exception as err:  # noqa: BLE001 -- one line naming the function
+        if _symbolic(args):
+            raise fail(ctx.lex, node, f"unsupported Modelica construct: external function "
+                       f"{cname} (called by {fn.name}) on time-varying arguments (it runs on "
+                       "values known when the model is built)") from None
         raise fail(ctx.lex, node, f"{fn.name}(): {err}") from None
     if len(out_names) == 1:
         local[out_names[0]] = got

@@ -19,7 +19,7 @@ class Env:
     Python element once created, and memoized values of its parameters."""
 
     __slots__ = ("view", "mods", "parent", "inst", "path", "_num", "_emod", "disabled",
-                 "_busy", "cached")
+                 "_busy", "cached", "pending")
 
     def __init__(self, view: ClassView, mods: dict[str, Mod], parent: Env | None,
                  path: str) -> None:
@@ -33,6 +33,8 @@ class Env:
         self.disabled: set[str] = set()
         self._busy: set[str] = set()
         self.cached: tuple | None = None
+        #: declaration equations of the instances below, evaluated once all are built
+        self.pending: list[tuple] = []
 
     def emod(self, name: str) -> Mod | None:
         """The merged modification of element ``name``: the outer one on top of the

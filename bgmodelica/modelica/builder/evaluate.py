@@ -8,7 +8,7 @@ import math
 from typing import Any
 
 from ...core import expressions as X
-from ...core.component import Element
+from ...core.component import Connector, Element
 from ...core.expr import Expr
 from .. import ast as A
 from .. import scope as S
@@ -214,8 +214,9 @@ def _member(elem: Element, name: str, numeric: bool, lex: Any, node: Any) -> Any
             raise _Disabled(name)
         info = env.view.elements[name]
         cat = _category(info, type_ref(info))
-        if cat in ("const", "string") or (numeric and cat == "param"):
-            return env.numeric(name)
+        if cat in ("const", "string") or (cat == "param" and (
+                numeric or isinstance(elem, Connector))):
+            return env.numeric(name)    # a connector's parameters have no symbol
     rename = elem.__dict__.get("_mo_rename")
     if rename:
         name = rename.get(name, name)
