@@ -208,7 +208,7 @@ def build_dae(sorted_dae: SortedDAE) -> CasadiDAE:
         z_start=np.array([_start(variables[j]) for j in alg_vars], dtype=float),
         fixed=fixed, observed_index=observed_index, discretes=list(model.discretes),
         hybrid=hybrid, n_variables=len(variables), bound=bound,
-        discrete_names={v.name for v in variables if v.decl.kind == "discrete"}
+        discrete_names={v.name for v in variables if _discrete_valued(v.decl)}
         | {d.name for d in shown},
         differentiated={v.name for v in variables if v.der >= 0}, aliases=dict(model.aliases),
         sorted=sorted_dae)
@@ -242,3 +242,8 @@ def attach_initial_equations(dae: CasadiDAE, model) -> None:
     dae.initial = res
     dae.initial_labels = [e.origin for e in eqs]
 
+
+def _discrete_valued(decl: object) -> bool:
+    """Whether a variable changes at events only: discrete, or an Integer or Boolean signal."""
+    return decl.kind == "discrete" or (decl.kind in ("input", "output")
+                                       and getattr(decl, "type_name", "Real") != "Real")

@@ -28,7 +28,7 @@ from .hybrid import (
     When,
     _Special,
 )
-from .variables import KIND_PARAMETER, TIME, Boolean, Symbol
+from .variables import KIND_OUTPUT, KIND_PARAMETER, TIME, Boolean, Symbol
 
 
 class RelationSlot(_Special):
@@ -85,11 +85,12 @@ def extract(pending: list[tuple[Any, Any]], where: Callable[[Any], str]
                         rw.scan(s.value, here, live=False)
                         continue
                     target = s.lhs.sym if isinstance(s.lhs, Leaf) else None
-                    if not isinstance(target, Symbol) or not target.is_discrete:
+                    if not isinstance(target, Symbol) or not (
+                            target.is_discrete or target.decl.kind == KIND_OUTPUT):
                         raise EquationError(
                             f"{here}: in when(), {s!r} must assign a discrete variable "
-                            "(Discrete, Integer or Boolean) on its left side; use reinit() for "
-                            "continuous variables")
+                            "(Discrete, Integer, Boolean or an output) on its left side; use "
+                            "reinit() for continuous variables")
                     if id(target) in draft.targets and draft.target_where[id(target)] != here:
                         raise EquationError(
                             f"{here}: {target.name} is also assigned in when() of "

@@ -12,7 +12,6 @@ C name (:mod:`bgmodelica.modelica.externals`).
 
 from __future__ import annotations
 
-import copy
 from typing import Any
 
 from ...core.expr import Expr
@@ -193,15 +192,17 @@ def _initial(comp: A.Component, lex: S.ClassScope, local: dict, info: Any) -> An
     zero: Any = "" if comp.type_name == "String" else (
         False if comp.type_name == "Boolean" else 0)
     for n in reversed(dims):
-        zero = [copy.deepcopy(zero) for _ in range(n)]
+        zero = [_lists(zero) for _ in range(n)]
     return zero
 
 
 class _State:
-    __slots__ = ("steps", "whens", "leaves", "guard")
+    __slots__ = ("steps", "whens", "leaves", "guard", "branching")
 
     def __init__(self) -> None:
         self.steps = 0
+        #: inside branches of an ``if`` on a time-varying condition (run both)
+        self.branching = 0
         #: True, or the time-varying condition under which no ``return`` has happened yet
         #: (assignments then keep the returned value where it is false)
         self.guard: Any = True
@@ -259,7 +260,7 @@ def _run(stmts: tuple, ctx: Ctx, state: _State) -> None:
                     raise fail(ctx.lex, st, f"while loop did not finish after {MAX_STEPS} "
                                "statements")
         elif t is A.StmtCall:
-            _call_statement(st, ctx)
+            _call_statement(st, ctx, state)
         elif t is A.Return:
             raise _Return()
         elif t is A.Break:
@@ -286,10 +287,11 @@ def _if(st: A.StmtIf, ctx: Ctx, state: _State) -> None:
         # a symbolic condition: both sides, merged
         rest = A.StmtIf(st.branches[k + 1:], st.otherwise, st.pos) if st.branches[k + 1:] \
             else None
-        then_vals = {n: copy.copy(v) for n, v in ctx.loops.items()}
-        else_vals = {n: copy.copy(v) for n, v in ctx.loops.items()}
+        then_vals = {n: _lists(v) for n, v in ctx.loops.items()}
+        else_vals = {n: _lists(v) for n, v in ctx.loops.items()}
         g0 = state.guard
         then_done = else_done = False
+        state.branching += 1
         try:
             _run(body, Ctx(ctx.env, ctx.lex, then_vals, False), state)
         except _Return:
@@ -297,7 +299,10 @@ def _if(st: A.StmtIf, ctx: Ctx, state: _State) -> None:
         except _Break:
             raise fail(ctx.lex, st, "break under a time-varying condition (not supported)") \
                 from None
+        finally:
+            state.branching -= 1
         g_then, state.guard = state.guard, g0
+        state.branching += 1
         try:
             if rest is not None:
                 _if(rest, Ctx(ctx.env, ctx.lex, else_vals, False), state)
@@ -308,6 +313,8 @@ def _if(st: A.StmtIf, ctx: Ctx, state: _State) -> None:
         except _Break:
             raise fail(ctx.lex, st, "break under a time-varying condition (not supported)") \
                 from None
+        finally:
+            state.branching -= 1
         g_else = state.guard
         for name in set(then_vals) | set(else_vals):
             a, b = then_vals.get(name), else_vals.get(name)
@@ -324,6 +331,12 @@ def _if(st: A.StmtIf, ctx: Ctx, state: _State) -> None:
                               ctx, st)
         return
     _run(st.otherwise, ctx, state)
+
+
+def _lists(v: Any) -> Any:
+    """A copy of the (nested) lists of ``v``; the values in them are shared (expressions
+    are immutable, and copying them would copy whole expression graphs)."""
+    return [_lists(x) for x in v] if isinstance(v, list) else v
 
 
 def _select(c: Any, a: Any, b: Any, ctx: Ctx, node: Any) -> Any:
@@ -421,7 +434,7 @@ def _store(ref: Any, value: Any, ctx: Ctx, node: Any) -> None:
         raise fail(ctx.lex, node, f"assignment to {name!r}, which is not a variable of the "
                    "function")
     if not subs:
-        ctx.loops[name] = copy.deepcopy(value) if isinstance(value, list) else value
+        ctx.loops[name] = _lists(value)
         return
     cur = ctx.loops[name]
     num = Ctx(ctx.env, ctx.lex, ctx.loops, False)
@@ -431,7 +444,7 @@ def _store(ref: Any, value: Any, ctx: Ctx, node: Any) -> None:
             idx.append(None)
             continue
         v = _known(evaluate(s, num), ctx)
-        if _symbolic(v):
+        if isinstance(v, list) and _symbolic(v):
             raise fail(ctx.lex, node, f"subscript of {name} depends on time-varying values")
         idx.append(v)
     ctx.loops[name] = _set(cur, idx, value, ctx, node, name)
@@ -444,6 +457,13 @@ def _set(cur: Any, idx: list, value: Any, ctx: Ctx, node: Any, name: str) -> Any
         raise fail(ctx.lex, node, f"{name}: too many subscripts")
     head, rest = idx[0], idx[1:]
     cur = list(cur)
+    if isinstance(head, Expr):
+        # a time-varying index: each element keeps its value unless the index names it
+        from .arith import _relation
+
+        return [_merge(_relation("==", head, p + 1, ctx, node),
+                       _set(x, rest, value, ctx, node, name), x, ctx, node)
+                for p, x in enumerate(cur)]
     if head is None:
         positions = list(range(len(cur)))
         vals = value if isinstance(value, list) else [value] * len(cur)
@@ -462,14 +482,14 @@ def _set(cur: Any, idx: list, value: Any, ctx: Ctx, node: Any, name: str) -> Any
     return cur
 
 
-def _call_statement(st: A.StmtCall, ctx: Ctx) -> None:
+def _call_statement(st: A.StmtCall, ctx: Ctx, state: _State) -> None:
     from .evaluate import evaluate
 
     call = st.call
     name = call.func.dotted
     if name == "assert":
         cond = evaluate(call.args[0], ctx)
-        if _symbolic(cond):
+        if _symbolic(cond) or state.branching:
             return                  # checked while simulating only for model equations
         if not cond:
             msg = evaluate(call.args[1], ctx) if len(call.args) > 1 else "assertion failed"
@@ -535,6 +555,10 @@ def _external(fn: FunctionDef, local: dict, ctx: Ctx, node: Any) -> None:
     except NotConstant:
         raise
     except Exception as err:  # noqa: BLE001 -- one line naming the function
+        if _symbolic(args):
+            raise fail(ctx.lex, node, f"unsupported Modelica construct: external function "
+                       f"{cname} (called by {fn.name}) on time-varying arguments (it runs on "
+                       "values known when the model is built)") from None
         raise fail(ctx.lex, node, f"{fn.name}(): {err}") from None
     if len(out_names) == 1:
         local[out_names[0]] = got
@@ -559,10 +583,11 @@ def section_equations(stmts: A.Statements, ctx: Ctx, out: list, initial: bool) -
     from .evaluate import evaluate
 
     names = _targets(stmts)
-    leaves = {n: evaluate(A.Ref(((n, None),), stmts.pos), ctx) for n in names}
+    leaves = {n: _leaf(n, ctx, stmts) if initial else evaluate(A.Ref(((n, None),), stmts.pos),
+                                                                ctx) for n in names}
     local = dict(ctx.loops)
     for n in names:
-        local[n] = _pre(leaves[n]) if not initial else None
+        local[n] = _pre(leaves[n]) if not initial else _unset(leaves[n])
     state = _State()
     state.whens = []
     state.leaves = leaves
@@ -577,7 +602,7 @@ def section_equations(stmts: A.Statements, ctx: Ctx, out: list, initial: bool) -
     for n in names:
         if n in in_when:
             continue
-        if local.get(n) is None:
+        if _has_unset(local.get(n)):
             raise fail(ctx.lex, stmts, f"{n} is not assigned on every path of the algorithm")
         if initial and (_discrete_start(leaves[n], local[n], ctx, stmts)
                         or _parameter_value(leaves[n], local[n], ctx, stmts)):
@@ -585,6 +610,28 @@ def section_equations(stmts: A.Statements, ctx: Ctx, out: list, initial: bool) -
         _equation(leaves[n], local[n], ctx, stmts, out)
     for branches in state.whens:
         out.append(_when_of(branches, leaves, ctx, stmts))
+
+
+def _leaf(name: str, ctx: Ctx, node: Any) -> Any:
+    """The variable ``name`` an initial algorithm assigns: a parameter (also a Boolean or
+    Integer one, otherwise a value when built) as its symbol."""
+    from .evaluate import evaluate, member
+
+    env = ctx.env
+    inst = env.inst if env is not None else None
+    if inst is not None and (name in inst._symbols or name in (
+            inst.__dict__.get("_mo_arrays") or ())):
+        return member(inst, name, False, ctx.lex, node)
+    return evaluate(A.Ref(((name, None),), node.pos), ctx)
+
+
+def _unset(v: Any) -> Any:
+    """``v``'s shape with no value yet (an initial algorithm assigns it)."""
+    return [_unset(x) for x in v] if isinstance(v, list) else None
+
+
+def _has_unset(v: Any) -> bool:
+    return any(_has_unset(x) for x in v) if isinstance(v, list) else v is None
 
 
 def _when_of(branches: list, leaves: dict, ctx: Ctx, node: Any) -> Any:

@@ -20,7 +20,7 @@ class Env:
     Python element once created, and memoized values of its parameters."""
 
     __slots__ = ("view", "mods", "parent", "inst", "path", "_num", "_emod", "disabled",
-                 "_busy", "cached")
+                 "_busy", "cached", "pending")
 
     def __init__(self, view: ClassView, mods: dict[str, Mod], parent: Env | None,
                  path: str) -> None:
@@ -34,6 +34,8 @@ class Env:
         self.disabled: set[str] = set()
         self._busy: set[str] = set()
         self.cached: tuple | None = None
+        #: declaration equations of the instances below, evaluated once all are built
+        self.pending: list[tuple] = []
 
     def emod(self, name: str) -> Mod | None:
         """The merged modification of element ``name``: the outer one on top of the
@@ -67,6 +69,8 @@ class Env:
             m = self.emod(name)
             if m is not None and m.has_binding:
                 value = m.value(True)
+            elif category == "param" and self._solved_initially(name, m):
+                return self._num[name]
             elif m is not None and "start" in m.sub and m.sub["start"].has_binding:
                 value = m.sub["start"].value(True)
             else:
@@ -78,6 +82,25 @@ class Env:
             self._busy.discard(name)
         self._num[name] = value
         return value
+
+
+    def _solved_initially(self, name: str, m: Mod | None) -> bool:
+        """Whether parameter ``name``, declared ``fixed = false``, took its value from the
+        initial equations and algorithms of the instance (run now when they can be)."""
+        fixed = m.sub.get("fixed") if m is not None else None
+        if fixed is None or not fixed.has_binding or fixed.value(True) is not False \
+                or self.inst is None or not self.view.initial \
+                or f"{name} (initial)" in self._busy:
+            return False
+        from .equations import equations_of
+
+        self._busy.discard(name)
+        self._busy.add(f"{name} (initial)")
+        try:
+            equations_of(self, self.view.initial, initial=True)
+        finally:
+            self._busy.discard(f"{name} (initial)")
+        return name in self._num
 
 
 def _default_value(tref: TypeRef) -> Any:

@@ -116,9 +116,10 @@ INITIAL_TIME = 0.0
 
 
 def _discrete_start(a: Any, b: Any, ctx: Ctx, node: Any) -> bool:
-    """An initial equation ``d = value`` of a discrete variable whose value is known when
-    the model is built sets its start value (its value before the first event)."""
-    from ...core.variables import KIND_DISCRETE
+    """An initial equation ``d = value`` of a discrete variable (or an Integer, Boolean or
+    enumeration output) whose value is known when the model is built sets its start value
+    (its value before the first event)."""
+    from ...core.variables import KIND_DISCRETE, KIND_OUTPUT
 
     if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
         if all(_discrete_start(x, y, ctx, node) for x, y in zip(a, b, strict=True)):
@@ -126,7 +127,8 @@ def _discrete_start(a: Any, b: Any, ctx: Ctx, node: Any) -> bool:
         return False
     sym = getattr(a, "sym", None) if isinstance(a, Expr) else None
     decl = getattr(sym, "decl", None)
-    if decl is None or decl.kind != KIND_DISCRETE:
+    if decl is None or not (decl.kind == KIND_DISCRETE or decl.kind == KIND_OUTPUT
+                            and getattr(decl, "type_name", "Real") != "Real"):
         return False
     try:
         # at initialization time is the start time, 0 in the examples of the libraries
@@ -171,9 +173,9 @@ def _parameter_value(a: Any, b: Any, ctx: Ctx, node: Any) -> bool:
             value = value.index
         if not isinstance(value, (bool, int, float)):
             return False
-        solved.append((sym, decl, float(value)))
+        solved.append((sym, decl, value))
     for sym, decl, value in solved:
-        sym.decl = decl.evolve(value=value)
+        sym.decl = decl.evolve(value=float(value))
         _remember(sym, value)
     return bool(solved)
 
@@ -308,9 +310,10 @@ def _connect(a: Any, b: Any, ctx: Ctx, node: Any, out: list) -> None:
             _connect(x, y, ctx, node, out)
         return
     own = _own_output(a, ctx), _own_output(b, ctx)
-    if own[0] is not None and own[1] is not None and own[0] != own[1]:
-        # an inside output connected to this block's own output (an outside connector):
-        # the outside one takes the inside one's value
+    if own[0] is not None and own[1] is not None and (own[0] or own[1]):
+        # an inside output connected to this block's own output (an outside connector), or
+        # two own outputs (specification 9.3: outside outputs are not sources): the outside
+        # one takes the other's value
         outer, inner = (a, b) if own[0] else (b, a)
         out.append(Equation(outer, inner))
         return

@@ -8,7 +8,7 @@ import math
 from typing import Any
 
 from ...core import expressions as X
-from ...core.component import Element
+from ...core.component import Connector, Element
 from ...core.expr import Expr
 from .. import ast as A
 from .. import scope as S
@@ -239,8 +239,9 @@ def _member(elem: Element, name: str, numeric: bool, lex: Any, node: Any) -> Any
             raise _Disabled(name)
         info = env.view.elements[name]
         cat = _category(info, type_ref(info))
-        if cat in ("const", "string") or (numeric and cat == "param"):
-            return env.numeric(name)
+        if cat in ("const", "string") or (cat == "param" and (
+                numeric or isinstance(elem, Connector))):
+            return env.numeric(name)    # a connector's parameters have no symbol
     rename = elem.__dict__.get("_mo_rename")
     if rename:
         name = rename.get(name, name)
@@ -292,8 +293,17 @@ def _subscript(val: Any, subs: tuple, ctx: Ctx, node: Any) -> Any:
         if isinstance(s, A.Colon):
             idx.append(None)
             continue
-        v = evaluate(s, Ctx(ctx.env, ctx.lex, ctx.loops, True))
-        v = numeric_value(v, ctx.lex, s)
+        try:
+            v = evaluate(s, Ctx(ctx.env, ctx.lex, ctx.loops, True))
+            v = numeric_value(v, ctx.lex, s)
+        except NotConstant:
+            if ctx.numeric:
+                raise
+            v = evaluate(s, ctx)        # a time-varying Integer index
+            if isinstance(v, Expr):
+                idx.append(v)
+                continue
+            v = numeric_value(v, ctx.lex, s)
         if isinstance(v, S.EnumValue):
             v = v.index
         if isinstance(v, list):
@@ -314,9 +324,25 @@ def _subscript(val: Any, subs: tuple, ctx: Ctx, node: Any) -> Any:
             return [apply(x, k + 1) for x in v]
         if isinstance(i, list):
             return [apply(_at(v, j, ctx, node), k + 1) for j in i]
+        if isinstance(i, Expr):
+            return _select(i, [apply(x, k + 1) for x in v], ctx, node)
         return apply(_at(v, i, ctx, node), k + 1)
 
     return apply(val, 0)
+
+
+def _select(i: Expr, items: list, ctx: Ctx, node: Any) -> Any:
+    """``items[i]`` for a time-varying Integer ``i``: ``if i == 1 then items[1] elseif ...``
+    (an index out of range takes the last element)."""
+    if not items:
+        raise fail(ctx.lex, node, f"index into the empty array {getattr(node, 'dotted', '')}")
+    if any(isinstance(x, Element) for x in _flatten(items)):
+        raise fail(ctx.lex, node, f"{getattr(node, 'dotted', 'expression')}: a component "
+                   "selected by a time-varying index")
+    out = items[-1]
+    for k in range(len(items) - 1, 0, -1):
+        out = _if_else(_relation("==", i, k, ctx, node), items[k - 1], out, ctx, node)
+    return out
 
 
 def _at(v: list, i: int, ctx: Ctx, node: Any) -> Any:

@@ -117,7 +117,15 @@ def instantiate(view: ClassView, mods: dict[str, Mod], parent: Env | None, path:
             bindings.append((sym, m, info))
     if bindings:
         owner = parent.inst if parent is not None else None
-        _declaration_equations(inst, bindings, connector, owner)
+        root = env
+        while root.parent is not None:
+            root = root.parent
+        # evaluated once the whole model is built: a modifier may read a later sibling
+        root.pending.append((inst, bindings, connector, owner))
+    if parent is None:
+        for args in env.pending:
+            _declaration_equations(*args)
+        env.pending.clear()
     if not view.validated:
         # evaluate the equations of the first instance of each class now, so that unknown
         # names, bad calls and wrong connects are reported when the model is loaded
@@ -171,7 +179,8 @@ def _plan(view: ClassView, env: Env, connector: bool) -> tuple:
         if name in _RESERVED and cat in ("param", "var"):
             raise fail(info.lex, comp, f"the name {name!r} is reserved by bgmodelica's "
                        "Component class; rename the variable")
-        if cat in ("const", "string"):
+        if cat in ("const", "string") or (connector and cat == "param"):
+            # a connector's parameters are values when built, not connection variables
             consts.append(name)
             continue
         if comp.dims or (tref.kind == "scalar" and tref.dims):
