@@ -326,6 +326,9 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         fn = self.fn
         self._time_next = math.inf
         self._update_tables(t0)
+        hyb = self.dae.hybrid
+        if hyb.initial >= 0:                 # initial() holds during initialization
+            self.p[self.dae.n_base + hyb.initial] = 1.0
         x, z = self._consistent(t0, None)
         for _ in range(self.opts.max_iterations):
             g, dgdt, *_ = self._step(t0, x, z)
@@ -339,12 +342,9 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         self.cond_pre = np.asarray(out[2], dtype=float).copy()
         if fn.initial_branch is not None:
             self.cond_pre[fn.initial_branch] = 0.0
-        self._set_pre_from(out)
+        self._set_pre_from(out, discrete=False)     # pre() of discrete variables: start
         samples = [slot for start, interval, slot in self.samples
                    if is_sample_instant(start, interval, t0)]
-        hyb = self.dae.hybrid
-        if hyb.initial >= 0:
-            self.p[self.dae.n_base + hyb.initial] = 1.0
         x, z, _ = self._iterate(t0, x, z, samples)
         return x, z
 
@@ -378,9 +378,13 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         """g, dgdt, cond, assign, reinit, pre, obs at (t, x, z) (copies)."""
         return [r.copy() for r in self._step_fast(t, x, z, self.p)]
 
-    def _set_pre_from(self, out) -> None:
-        if self.fn.pre_slot.size:
-            self.p[self.fn.pre_slot] = out[5]
+    def _set_pre_from(self, out, discrete: bool = True) -> None:
+        """pre() slots from the step outputs ``out``; with ``discrete`` False only those of
+        continuous-time variables (discrete ones keep their start value at initialization)."""
+        fn = self.fn
+        if fn.pre_slot.size:
+            keep = np.zeros(len(fn.pre_slot), dtype=bool) if discrete else fn.pre_discrete
+            self.p[fn.pre_slot] = np.where(keep, self.p[fn.pre_slot], out[5])
 
     def _update_tables(self, t: float) -> None:
         for table, i0, i1 in self.tables:
