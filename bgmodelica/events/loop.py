@@ -112,6 +112,7 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         self.cond_pre = np.zeros(0)
         self._time_next = math.inf
         self._time_cause = ""
+        self._stretch = math.inf        # longest stretch to integrate at once [s]
         self.recent: deque[tuple[float, str]] = deque(maxlen=self.opts.zeno_events)
         self.init_notes: list[str] = []           # of the initial conditions
 
@@ -140,6 +141,8 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
             t_end = t_event
             if self.selection is not None:       # short stretches: a failure costs little
                 t_end = _snap(grid, k_out, min(t_event, t + self.selection.stretch))
+            if t + self._stretch < t_end:        # shortened after a failed integration
+                t_end = _snap(grid, k_out, t + self._stretch)
             j = k_out
             while j < len(grid) and grid[j] < t_end:
                 j += 1
@@ -215,19 +218,24 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
             uniform[:-1] = np.where(close, pick, uniform[:-1])
         offsets = np.union1d(out_offsets, uniform)
         offsets = offsets[offsets > 0]
+        retry = (sel is not None or bool(fn.state_rel)) and t1 - t0 >= 1e-12 * max(1.0, abs(t0))
         try:
-            if sel is None:
+            if not retry:
                 X, Z = self._columns(t0, x, z, offsets)
             else:        # a failure is expected now and then (retried): keep SUNDIALS quiet
                 with _quiet_stderr():
                     X, Z = self._columns(t0, x, z, offsets)
         except RuntimeError:
             # with dynamic state selection the current choice may fail before the next pivot
-            # check: integrate a shorter stretch, whose checks switch the states in time
-            if sel is None or t1 - t0 < 1e-12 * max(1.0, abs(t0)):
+            # check, and a branch kept past a crossing not yet checked may be singular (a
+            # force ~ 1/v beyond the switch to its regularization): integrate a shorter
+            # stretch, whose checks switch in time
+            if not retry:
                 raise
             t_short = t0 + 0.25 * (t1 - t0)
+            self._stretch = t_short - t0
             return self._advance(t0, t_short, x, z, outs[outs < t_short])
+        self._stretch = 2 * self._stretch if t1 - t0 >= self._stretch else self._stretch
         nz = self.dae.z.numel()
         ts = t0 + offsets
         out_cols = np.searchsorted(offsets, out_offsets)

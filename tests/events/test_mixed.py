@@ -113,3 +113,25 @@ def test_ideal_diode_bridge_commutates():
     assert not np.any(on["d1"] & on["d3"]) and not np.any(on["d2"] & on["d4"])
     assert np.any(on["d1"] & on["d4"]) and np.any(on["d2"] & on["d3"])   # both half-waves
     assert 300 < res["vc"][-1] < 325 - 4
+
+
+INVERSE = """
+model InverseBrake "A braking force ~ 1/v, regularized below v0"
+  parameter Real v0 = 1;
+  Real v(start = 10, fixed = true);
+equation
+  der(v) = if abs(v) < v0 then -100*v/v0 else -100/v;
+end InverseBrake;
+"""
+
+
+def test_singular_branch_past_an_unchecked_crossing():
+    """v^2 = 100 - 200 t reaches v0 = 1 at t = 0.495; beyond, the frozen 1/v branch blows up
+    before the next check, so the integration is retried on shorter stretches."""
+    res = bg.simulate(load_modelica_text(INVERSE), stop_time=5.0, interval=1e-3,
+                      rtol=1e-10, atol=1e-12)
+    assert res.meta["event_times"][0] == pytest.approx(0.495, abs=1e-7)
+    t = res["time"]
+    k = np.searchsorted(t, 0.52)
+    assert res["v"][k] == pytest.approx(np.exp(-100 * (t[k] - 0.495)), rel=1e-4)
+    assert abs(res["v"][-1]) < 1e-12
