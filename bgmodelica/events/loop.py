@@ -30,6 +30,7 @@ from ..backends.casadi_dae import CasadiDAE
 from ..backends.casadi_init import initialize
 from ..core.flatmodel import HybridPart
 from ..errors import SimulationError
+from . import mixed
 from .crossings import CrossingMixin
 from .fast import Fast
 from .functions import HybridFunctions, build
@@ -47,13 +48,16 @@ class EventError(SimulationError):
 class EventOptions:
     """max_iterations: event-iteration bound; checks: indicator checks per segment;
     event_tol: time tolerance of state-event location [s] (relative to max(1, |t|));
-    zeno_events: consecutive events closer than ``zeno_dt`` that count as chattering."""
+    zeno_events: consecutive events closer than ``zeno_dt`` that count as chattering;
+    relation_tol: an indicator this close to zero may keep either relation value when the
+    event iteration has to search a mixed system (see :mod:`.mixed`)."""
 
     max_iterations: int = 100
     checks: int = 8
     event_tol: float = 1e-13
     zeno_events: int = 50
     zeno_dt: float = 1e-10
+    relation_tol: float = 1e-8
 
 
 @dataclass
@@ -108,6 +112,7 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         self.cond_pre = np.zeros(0)
         self._time_next = math.inf
         self._time_cause = ""
+        self._stretch = math.inf        # longest stretch to integrate at once [s]
         self.recent: deque[tuple[float, str]] = deque(maxlen=self.opts.zeno_events)
         self.init_notes: list[str] = []           # of the initial conditions
 
@@ -136,6 +141,8 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
             t_end = t_event
             if self.selection is not None:       # short stretches: a failure costs little
                 t_end = _snap(grid, k_out, min(t_event, t + self.selection.stretch))
+            if t + self._stretch < t_end:        # shortened after a failed integration
+                t_end = _snap(grid, k_out, t + self._stretch)
             j = k_out
             while j < len(grid) and grid[j] < t_end:
                 j += 1
@@ -211,19 +218,24 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
             uniform[:-1] = np.where(close, pick, uniform[:-1])
         offsets = np.union1d(out_offsets, uniform)
         offsets = offsets[offsets > 0]
+        retry = (sel is not None or bool(fn.state_rel)) and t1 - t0 >= 1e-12 * max(1.0, abs(t0))
         try:
-            if sel is None:
+            if not retry:
                 X, Z = self._columns(t0, x, z, offsets)
             else:        # a failure is expected now and then (retried): keep SUNDIALS quiet
                 with _quiet_stderr():
                     X, Z = self._columns(t0, x, z, offsets)
         except RuntimeError:
             # with dynamic state selection the current choice may fail before the next pivot
-            # check: integrate a shorter stretch, whose checks switch the states in time
-            if sel is None or t1 - t0 < 1e-12 * max(1.0, abs(t0)):
+            # check, and a branch kept past a crossing not yet checked may be singular (a
+            # force ~ 1/v beyond the switch to its regularization): integrate a shorter
+            # stretch, whose checks switch in time
+            if not retry:
                 raise
             t_short = t0 + 0.25 * (t1 - t0)
+            self._stretch = t_short - t0
             return self._advance(t0, t_short, x, z, outs[outs < t_short])
+        self._stretch = 2 * self._stretch if t1 - t0 >= self._stretch else self._stretch
         nz = self.dae.z.numel()
         ts = t0 + offsets
         out_cols = np.searchsorted(offsets, out_offsets)
@@ -326,6 +338,9 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         fn = self.fn
         self._time_next = math.inf
         self._update_tables(t0)
+        hyb = self.dae.hybrid
+        if hyb.initial >= 0:                 # initial() holds during initialization
+            self.p[self.dae.n_base + hyb.initial] = 1.0
         x, z = self._consistent(t0, None)
         for _ in range(self.opts.max_iterations):
             g, dgdt, *_ = self._step(t0, x, z)
@@ -339,12 +354,9 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         self.cond_pre = np.asarray(out[2], dtype=float).copy()
         if fn.initial_branch is not None:
             self.cond_pre[fn.initial_branch] = 0.0
-        self._set_pre_from(out)
+        self._set_pre_from(out, discrete=False)     # pre() of discrete variables: start
         samples = [slot for start, interval, slot in self.samples
                    if is_sample_instant(start, interval, t0)]
-        hyb = self.dae.hybrid
-        if hyb.initial >= 0:
-            self.p[self.dae.n_base + hyb.initial] = 1.0
         x, z, _ = self._iterate(t0, x, z, samples)
         return x, z
 
@@ -378,9 +390,13 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         """g, dgdt, cond, assign, reinit, pre, obs at (t, x, z) (copies)."""
         return [r.copy() for r in self._step_fast(t, x, z, self.p)]
 
-    def _set_pre_from(self, out) -> None:
-        if self.fn.pre_slot.size:
-            self.p[self.fn.pre_slot] = out[5]
+    def _set_pre_from(self, out, discrete: bool = True) -> None:
+        """pre() slots from the step outputs ``out``; with ``discrete`` False only those of
+        continuous-time variables (discrete ones keep their start value at initialization)."""
+        fn = self.fn
+        if fn.pre_slot.size:
+            keep = np.zeros(len(fn.pre_slot), dtype=bool) if discrete else fn.pre_discrete
+            self.p[fn.pre_slot] = np.where(keep, self.p[fn.pre_slot], out[5])
 
     def _update_tables(self, t: float) -> None:
         for table, i0, i1 in self.tables:
@@ -413,6 +429,7 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
             self.p[slot] = 1.0
         flags = bool(samples) or dae.hybrid.initial >= 0 and self.p[nb + dae.hybrid.initial]
         changing: list[str] = []
+        cycle = _Cycle(len(fn.rel_slot))
         for _ in range(self.opts.max_iterations):
             if fn.alg_solver is not None:
                 z = self._solve_z(t, x)
@@ -420,11 +437,14 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
             g, dgdt, cond, assign, reinit, pre_src, _ = out
             changing = []
             rel = self._relation_values(t, g, dgdt)
-            moved = rel != self.p[fn.rel_slot]
+            moved = cycle.moved(rel, self.p[fn.rel_slot], g, self.opts.relation_tol)
             if moved.any():
                 changing += [fn.relations[k].text for k in np.nonzero(moved)[0][:4]]
+                if cycle.closes(self.p[fn.rel_slot], rel, moved):
+                    rel = self._settle(t, x, cycle)
                 self.p[fn.rel_slot] = rel
                 continue
+            cycle.reset()
             fired = []
             for ids in fn.branch_of:
                 for b in ids:
@@ -477,6 +497,32 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         self._schedule_time_relations(t, out[0], out[1])
         return x, z, out
 
+    def _settle(self, t: float, x, cycle: _Cycle) -> np.ndarray:
+        """Relation values of a mixed system whose event iteration cycles (see
+        :mod:`.mixed`); raises :class:`EventError` when no combination is consistent."""
+        fn = self.fn
+        saved = self.p[fn.rel_slot].copy()
+
+        def evaluate(trial: np.ndarray):
+            self.p[fn.rel_slot] = trial
+            z = self._solve_z(t, x) if fn.alg_solver is not None else np.zeros(0)
+            g, dgdt, *_ = self._step(t, x, z)
+            return self._relation_values(t, g, dgdt), g
+
+        free = list(np.nonzero(cycle.free)[0])
+        names = ", ".join(dict.fromkeys(fn.relations[k].text for k in free[:6]))
+        if len(free) > mixed.MAX_FREE:
+            raise EventError(f"event iteration at t = {t:g} s cycles through {len(free)} "
+                             f"relations ({names}, ...), too many to search", t)
+        found, miss = mixed.search(evaluate, cycle.first, free, self.opts.relation_tol)
+        self.p[fn.rel_slot] = saved
+        if found is None:
+            raise EventError(f"event iteration at t = {t:g} s: no consistent values of "
+                             f"{names} (the mixed system they close has no solution; the "
+                             f"closest misses by {miss:.3g})", t)
+        cycle.settled(found)
+        return found
+
     def _note(self, t: float, cause: str) -> None:
         kind = cause.split(":", 1)[0]
         self.log.times.append(t)
@@ -498,6 +544,40 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
 
     def _obs(self, t, x, z) -> np.ndarray:
         return self._step_fast(t, x, z, self.p)[6][self.obs_idx]
+
+
+class _Cycle:
+    """Bookkeeping of relation values within one event iteration: the first values, the
+    combinations seen, which relations moved, and which were settled by a search."""
+
+    def __init__(self, n: int) -> None:
+        self.first: np.ndarray | None = None
+        self.seen: set[bytes] = set()
+        self.free = np.zeros(n, dtype=bool)
+        self.tolerant = np.zeros(n, dtype=bool)
+
+    def moved(self, rel: np.ndarray, frozen: np.ndarray, g: np.ndarray, tol: float):
+        """Relations whose value changes; a settled one changes only beyond ``tol``."""
+        if self.first is None:
+            self.first = rel.copy()
+        return (rel != frozen) & ~(self.tolerant & (np.abs(g) <= tol))
+
+    def closes(self, frozen: np.ndarray, rel: np.ndarray, moved: np.ndarray) -> bool:
+        """Record a step from ``frozen`` to ``rel``; True when ``rel`` was seen before."""
+        self.seen.add(frozen.tobytes())
+        self.free |= moved
+        return rel.tobytes() in self.seen
+
+    def settled(self, rel: np.ndarray) -> None:
+        self.tolerant |= self.free
+        self.first = rel.copy()
+        self.seen.clear()
+        self.free[:] = False
+
+    def reset(self) -> None:
+        """The relations are stable: discrete changes may start a new cycle."""
+        self.seen.clear()
+        self.free[:] = False
 
 
 def _snap(grid: np.ndarray, k: int, t: float) -> float:
