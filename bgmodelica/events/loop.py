@@ -212,15 +212,17 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         offsets = np.union1d(out_offsets, uniform)
         offsets = offsets[offsets > 0]
         try:
-            if sel is None:
+            if sel is None and not fn.state_rel:
                 X, Z = self._columns(t0, x, z, offsets)
             else:        # a failure is expected now and then (retried): keep SUNDIALS quiet
                 with _quiet_stderr():
                     X, Z = self._columns(t0, x, z, offsets)
         except RuntimeError:
             # with dynamic state selection the current choice may fail before the next pivot
-            # check: integrate a shorter stretch, whose checks switch the states in time
-            if sel is None or t1 - t0 < 1e-12 * max(1.0, abs(t0)):
+            # check, and past a state event the frozen relations may make the model fail
+            # (a sign(v) chattering at v = 0): integrate a shorter stretch, whose checks
+            # switch the states or find the event in time
+            if (sel is None and not fn.state_rel) or t1 - t0 < 1e-12 * max(1.0, abs(t0)):
                 raise
             t_short = t0 + 0.25 * (t1 - t0)
             return self._advance(t0, t_short, x, z, outs[outs < t_short])
