@@ -405,6 +405,9 @@ def load(folder: Path, key: str, model: Component,
     if not all(isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool)
                for v in values.values()):
         return None                      # compiling names the bad value
+    evaluated = getattr(compiled, "evaluated", None) or {}
+    if any(values.get(name, value) != value for name, value in evaluated.items()):
+        return None                      # a parameter that changed the structure changed
     compiled.source = model
     _set_parameter_values(compiled, values)
     return compiled

@@ -21,6 +21,7 @@ from .passes.reference import check_references
 from .passes.sorting import SortedDAE, sort_equations
 from .passes.state_select import check_alias_state_select, check_states
 from .passes.units import check_units
+from .passes.zero_terms import evaluate_zero_terms
 from .structure.graph import gc_paused
 
 
@@ -52,6 +53,9 @@ class CompiledModel:
     n_flat_equations: int      # before alias elimination
     timings: dict[str, float] = field(default_factory=dict)
     source: Any = None         # the component it came from
+    #: parameters replaced by their value because it removes a term (see
+    #: :mod:`bgmodelica.passes.zero_terms`): name -> value; not tunable
+    evaluated: dict[str, float] = field(default_factory=dict)
 
     @property
     def compile_time(self) -> float:
@@ -270,10 +274,12 @@ def _compile(model: Component, select: Selector | None, units: str = "error") ->
     flat = eliminate_aliases(flat)
     flat.asserts = raw.asserts
     lap("alias")
+    flat, evaluated = evaluate_zero_terms(flat)
+    lap("zero_terms")
     try:
         balance = check_balance(flat)
         lap("balance")
-        return _reduce_and_build(flat, balance, n_flat, timings, model, select)
+        return _reduce_and_build(flat, balance, n_flat, timings, model, select, evaluated)
     except UnbalancedModelError:
         check_references(raw, force=True)  # large models: the likely cause, if it is that
         raise
@@ -282,12 +288,13 @@ def _compile(model: Component, select: Selector | None, units: str = "error") ->
 def recompile(compiled: CompiledModel, select: Selector) -> CompiledModel:
     """The same model with another state selection (index reduction onwards)."""
     return _reduce_and_build(compiled.flat, compiled.balance, compiled.n_flat_equations, {},
-                             compiled.source, select)
+                             compiled.source, select, compiled.evaluated)
 
 
 def _reduce_and_build(flat: FlatModel, balance: BalanceReport, n_flat: int,
                       timings: dict[str, float], source: Any,
-                      select: Selector | None) -> CompiledModel:
+                      select: Selector | None,
+                      evaluated: dict[str, float] | None = None) -> CompiledModel:
     lap = Laps(timings)
     reduced = reduce_index(flat, select=select)
     if select is None:
@@ -297,6 +304,7 @@ def _reduce_and_build(flat: FlatModel, balance: BalanceReport, n_flat: int,
     lap("sorting")
     dae = build_dae(sorted_dae)
     attach_initial_equations(dae, flat)
+    dae.evaluated = dict(evaluated or {})
     lap("backend")
     return CompiledModel(flat.name, flat, balance, reduced, sorted_dae, dae, n_flat, timings,
-                         source)
+                         source, dict(evaluated or {}))

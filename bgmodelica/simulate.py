@@ -317,6 +317,14 @@ def _split_overrides(dae: CasadiDAE, params: dict[str, Any]):
                                  f"({name}) with conflicting values")
         given[name] = (key, val)
         target[name] = val
+    evaluated = getattr(dae, "evaluated", None) or {}
+    for key in list(unknown):
+        if key in evaluated and _number(key, params[key]) != evaluated[key]:
+            from .backends.casadi_dae import evaluated_error
+
+            raise evaluated_error(key, evaluated[key])
+        if key in evaluated:
+            unknown.remove(key)                    # its value already
     if unknown:
         known = pnames + dae.names[:n_var] + list(aliases)
         raise ParameterError(f"{unknown[0]!r} is not a parameter, input or variable of the "

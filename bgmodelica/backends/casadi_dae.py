@@ -62,6 +62,8 @@ class CasadiDAE:
     #: (``initial equation TEXT [component]``); see :func:`attach_initial_equations`
     initial: ca.SX = field(default_factory=lambda: ca.SX(0, 1))
     initial_labels: list[str] = field(default_factory=list)
+    #: parameters evaluated when compiling (name -> value): not settable
+    evaluated: dict[str, float] = field(default_factory=dict)
 
     def __repr__(self) -> str:
         return (f"CasadiDAE({self.x.numel()} states, {self.z.numel()} algebraic, "
@@ -117,6 +119,10 @@ class CasadiDAE:
             where = {n: k for k, n in enumerate(names)}
             units = [v.decl.unit for v in (*self.parameters, *self.inputs, *self.discretes)]
             for key, value in overrides.items():
+                if key in self.evaluated and _number(key, value) == self.evaluated[key]:
+                    continue
+                if key in self.evaluated:
+                    raise evaluated_error(key, self.evaluated[key])
                 if key not in where:
                     close = [n for n in names if n.split(".")[-1] == key.split(".")[-1]]
                     hint = f"; did you mean {', '.join(close[:5])}?" if close else ""
@@ -124,6 +130,13 @@ class CasadiDAE:
                                          f"model{hint}")
                 vec[where[key]] = _number(key, value, units[where[key]])
         return vec
+
+
+def evaluated_error(name: str, value: float) -> ParameterError:
+    """The error for setting a parameter that compiling replaced by its value."""
+    return ParameterError(f"{name!r} was evaluated when compiling (its value {value:g} "
+                          "removes a term from the equations); change it in the model and "
+                          "compile again")
 
 
 def _number(name: str, value: object, unit: str | None = None) -> float:

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ...core.expr import Expr
+from ...core.expr import RELATIONS, Expr, Op
 from .. import ast as A
 from .. import scope as S
 from .arith import _if_else
@@ -37,7 +37,8 @@ class FunctionDef:
     """A function class with its ``extends`` merged: inputs, outputs, protected variables
     (declaration order) and the algorithm or external clause."""
 
-    __slots__ = ("scope", "inputs", "outputs", "locals", "algorithms", "external", "name")
+    __slots__ = ("scope", "inputs", "outputs", "locals", "algorithms", "external", "name",
+                 "events")
 
     def __init__(self, scope: S.ClassScope) -> None:
         from .classes import class_view
@@ -64,6 +65,17 @@ class FunctionDef:
                 self.algorithms.append((section, s))
             if s.cdef.external is not None and self.external is None:
                 self.external = (s.cdef.external, s)
+        #: ``annotation(GenerateEvents=true)``: relations in the body trigger events
+        self.events = any(_flag(s.cdef.annotation, "GenerateEvents") for s in _bases(scope))
+
+
+def _flag(annotation: A.Modification | None, name: str) -> bool:
+    """Whether ``annotation`` sets ``name = true``."""
+    if annotation is None:
+        return False
+    return any(isinstance(arg, A.ElementMod) and arg.name == name and arg.mod is not None
+               and isinstance(arg.mod.binding, A.Bool) and arg.mod.binding.value
+               for arg in annotation.args)
 
 
 def _bases(scope: S.ClassScope) -> list[S.ClassScope]:
@@ -157,11 +169,57 @@ def apply_function(scope: S.ClassScope, args: list, kwargs: dict, ctx: Ctx, node
     for (c, _, _), v in zip(fn.outputs, outs, strict=True):
         if v is None:
             raise fail(ctx.lex, node, f"{fn.name}(): output {c.name} is never assigned")
+    if not fn.events:
+        given: set[int] = set()
+        _nodes([*args, *kwargs.values()], given)
+        memo: dict[int, Any] = {}
+        outs = [_literal(v, given, memo) if c.type_name == "Real" else v
+                for (c, _, _), v in zip(fn.outputs, outs, strict=True)]
     if all_outputs:
         return tuple(outs)
     if not outs:
         return None
     return outs[0]
+
+
+def _nodes(value: Any, seen: set[int]) -> None:
+    """Record in ``seen`` the ids of the expression nodes in ``value`` (arrays as lists)."""
+    stack = [value]
+    while stack:
+        v = stack.pop()
+        if isinstance(v, (list, tuple)):
+            stack.extend(v)
+        elif isinstance(v, Op) and id(v) not in seen:
+            seen.add(id(v))
+            stack.extend(v.args)
+
+
+def _literal(value: Any, given: set[int], memo: dict[int, Any]) -> Any:
+    """``value`` with the relations the function body made (not those of its arguments,
+    ``given``) taken literally: relations in a function trigger no events (specification
+    12.7, unless ``GenerateEvents=true``)."""
+    if isinstance(value, (list, tuple)):
+        return type(value)(_literal(v, given, memo) for v in value)
+    stack = [value]
+    while stack:                                  # post-order, without recursion
+        v = stack[-1]
+        if not isinstance(v, Op) or id(v) in memo:
+            stack.pop()
+            continue
+        if id(v) in given or v.op == "noEvent":
+            memo[id(v)] = v
+        elif v.op in RELATIONS:
+            memo[id(v)] = Op("noEvent", (v,))
+        else:
+            todo = [a for a in v.args if isinstance(a, Op) and id(a) not in memo]
+            if todo:
+                stack.extend(todo)
+                continue
+            args = tuple(memo.get(id(a), a) if isinstance(a, Op) else a for a in v.args)
+            memo[id(v)] = v if all(x is y for x, y in zip(args, v.args, strict=True)) \
+                else Op(v.op, args)
+        stack.pop()
+    return memo.get(id(value), value) if isinstance(value, Op) else value
 
 
 def _binding(info: Any) -> Any:
