@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import time as _time
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -16,7 +17,7 @@ from .compiler import CompiledModel, compile
 from .core.component import Component
 from .core.units import with_units
 from .diagnose import check_initial_point, check_result, unsafe_outputs
-from .errors import ParameterError, SimulationError
+from .errors import ModelError, ParameterError, SimulationError
 from .events.fast import Fast
 from .integration import _integrate, _integrator, _xdot  # noqa: F401 (used by studies)
 from .result import Result
@@ -39,6 +40,28 @@ _HINTS = {
 }
 
 
+def _located(fn: Callable) -> Callable:
+    """An internal exception (CasADi's, Python's) while simulating a model read from Modelica
+    becomes one line at the model's class rather than a traceback."""
+    @functools.wraps(fn)
+    def run(model: Any, *args: Any, **kwargs: Any) -> Any:
+        try:
+            return fn(model, *args, **kwargs)
+        except ModelError:
+            raise
+        except (RecursionError, RuntimeError, KeyError, IndexError, TypeError,
+                AttributeError, ZeroDivisionError) as err:
+            from .modelica.errors import compile_failure
+
+            located = compile_failure(getattr(model, "source", None) or model, err,
+                                      "simulate")
+            if located is None:
+                raise
+            raise located from None
+    return run
+
+
+@_located
 def simulate(model: Component | CompiledModel | str, stop_time: float = 1.0,
              interval: float | None = None, params: dict[str, Any] | None = None, *,
              start_time: float = 0.0, rtol: float = 1e-6, atol: float = 1e-8,

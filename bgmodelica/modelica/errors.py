@@ -44,13 +44,14 @@ def internal_text(err: BaseException) -> str:
     return f"unsupported construct or internal error ({type(err).__name__}: {text})"
 
 
-def compile_failure(model: Any, err: BaseException) -> ModelicaError | None:
-    """For a model read from Modelica, an internal exception of its compilation as one line
-    at the model's class (None for other models)."""
+def compile_failure(model: Any, err: BaseException, stage: str = "compile"
+                    ) -> ModelicaError | None:
+    """For a model read from Modelica, an internal exception of its compilation (or
+    simulation: ``stage``) as one line at the model's class (None for other models)."""
     where = getattr(model, "__dict__", {}).get("_mo_where")
     if where is None:
         return None
-    return ModelicaError(f"{where}: cannot compile this model: {internal_text(err)}")
+    return ModelicaError(f"{where}: cannot {stage} this model: {internal_text(err)}")
 
 
 def locate_error(model: Any, err: BaseException) -> None:
