@@ -45,7 +45,13 @@ EXAMPLES = ["Mechanics.Rotational.Examples.First",
             "Blocks.Examples.PID_Controller",
             "Blocks.Examples.LogicalNetwork1",
             "Mechanics.Translational.Examples.Damper",
-            "Thermal.HeatTransfer.Examples.TwoMasses"]
+            "Thermal.HeatTransfer.Examples.TwoMasses",
+            "Blocks.Examples.RealNetwork1",
+            "Blocks.Examples.IntegerNetwork1",
+            "Blocks.Examples.BooleanNetwork1",
+            "Electrical.Analog.Examples.AD_DA_conversion",
+            "Electrical.Analog.Examples.GenerationOfFMUs",
+            "Thermal.HeatTransfer.Examples.GenerationOfFMUs"]
 
 
 @pytest.mark.parametrize("name", EXAMPLES)

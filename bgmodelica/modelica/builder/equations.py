@@ -7,7 +7,7 @@ from __future__ import annotations
 from typing import Any
 
 from ...core import hybrid as H
-from ...core.component import Element, connect
+from ...core.component import Connector, Element, connect
 from ...core.expr import Equation, Expr
 from ...errors import ConnectError, DeclarationError, EquationError, ModelError
 from .. import ast as A
@@ -309,6 +309,9 @@ def _connect(a: Any, b: Any, ctx: Ctx, node: Any, out: list) -> None:
         for x, y in zip(a, b, strict=True):
             _connect(x, y, ctx, node, out)
         return
+    if isinstance(a, Connector) and isinstance(b, Connector) and (a._children or b._children):
+        _connect_nested(a, b, ctx, node, out)
+        return
     own = _own_output(a, ctx), _own_output(b, ctx)
     if own[0] is not None and own[1] is not None and (own[0] or own[1]):
         # an inside output connected to this block's own output (an outside connector), or
@@ -318,6 +321,18 @@ def _connect(a: Any, b: Any, ctx: Ctx, node: Any, out: list) -> None:
         out.append(Equation(outer, inner))
         return
     out.append(connect(a, b))
+
+
+def _connect_nested(a: Connector, b: Connector, ctx: Ctx, node: Any, out: list) -> None:
+    """Connectors holding connectors (a plug of pins): their connectors are connected pairwise
+    by name, their own variables as a connector."""
+    if set(a._children) != set(b._children):
+        raise fail(ctx.lex, node, f"cannot connect {a.name} ({', '.join(a._children)}) to "
+                   f"{b.name} ({', '.join(b._children)}): incompatible connectors")
+    for name, child in a._children.items():
+        _connect(child, b._children[name], ctx, node, out)
+    if a._symbols or b._symbols:
+        out.append(connect(a, b))
 
 
 def _own_output(x: Any, ctx: Ctx) -> bool | None:
