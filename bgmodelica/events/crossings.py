@@ -17,19 +17,19 @@ class CrossingMixin:
     def _locate(self, lo_t, lo_x, lo_z, g_lo, hi_t, hi_x, hi_z, g_hi, frozen):
         """Illinois iteration on the earliest crossing indicator in [lo_t, hi_t]."""
         fn = self.fn
-        strict = fn.strict[fn.state_rel]
         tol = self.opts.event_tol * max(1.0, abs(hi_t))
-        g_lo = np.array(g_lo, dtype=float)
-        g_hi = np.array(g_hi, dtype=float)
+        shift = np.where(frozen, 1.0, -1.0) * self._hysteresis()
+        raw_hi = np.array(g_hi, dtype=float)
+        s_lo = np.array(g_lo, dtype=float) + shift      # zero where the relation leaves
+        s_hi = raw_hi + shift
         side = 0
         widths = [hi_t - lo_t]
         for _ in range(400):
             if hi_t - lo_t <= tol:
                 break
-            changed = self._values(g_hi[:, None], strict)[:, 0] != frozen
             cand = hi_t
-            for k in np.nonzero(changed)[0]:
-                a, b = g_lo[k], g_hi[k]
+            for k in np.nonzero(self._crossed(raw_hi[:, None], frozen)[:, 0])[0]:
+                a, b = s_lo[k], s_hi[k]
                 if a != b:
                     tc = lo_t + (hi_t - lo_t) * a / (a - b)
                     cand = min(cand, tc)
@@ -41,21 +41,32 @@ class CrossingMixin:
                 cand = 0.5 * (lo_t + hi_t)
             xc, zc = self._integrate_one(lo_t, cand, lo_x, lo_z)
             gc = self._ind(cand, xc, zc)
-            if (self._values(gc[:, None], strict)[:, 0] != frozen).any():
-                hi_t, hi_x, hi_z, g_hi = cand, xc, zc, gc
+            if self._crossed(gc[:, None], frozen)[:, 0].any():
+                hi_t, hi_x, hi_z, raw_hi, s_hi = cand, xc, zc, gc, gc + shift
                 if side == 1:
-                    g_lo = g_lo * 0.5
+                    s_lo = s_lo * 0.5
                 side = 1
             else:
-                lo_t, lo_x, lo_z, g_lo = cand, xc, zc, gc
+                lo_t, lo_x, lo_z, s_lo = cand, xc, zc, gc + shift
                 if side == -1:
-                    g_hi = g_hi * 0.5
+                    s_hi = s_hi * 0.5
                 side = -1
             widths.append(hi_t - lo_t)
-        changed = self._values(g_hi[:, None], strict)[:, 0] != frozen
+        changed = self._crossed(raw_hi[:, None], frozen)[:, 0]
         cause = " and ".join(self.fn.relations[fn.state_rel[k]].text
                              for k in np.nonzero(changed)[0][:3])
         return hi_t, hi_x, hi_z, f"state:{cause}"
+
+    def _hysteresis(self) -> np.ndarray:
+        """Per state relation: how far past zero its indicator must go to change it (0, or
+        the tolerance of a value kept against rounding-level indicators, see .mixed)."""
+        return self.hysteresis[self.fn.state_rel]
+
+    def _crossed(self, g: np.ndarray, frozen: np.ndarray) -> np.ndarray:
+        """Per state relation and column of ``g``: the relation left its frozen value."""
+        strict = self.fn.strict[self.fn.state_rel][:, None]
+        values = np.where(strict, g > 0, g >= 0)
+        return (values != frozen[:, None]) & (np.abs(g) >= self._hysteresis()[:, None])
 
     def _ind(self, t, x, z) -> np.ndarray:
         return self._ind_fast(t, x, z, self.p)[0].copy()
@@ -65,10 +76,6 @@ class CrossingMixin:
         if key not in self.dae.cache:
             self.dae.cache[key] = self.fn.indicators.map(m)
         return self.dae.cache[key]
-
-    @staticmethod
-    def _values(g: np.ndarray, strict: np.ndarray) -> np.ndarray:
-        return np.where(strict[:, None], g > 0, g >= 0)
 
     def _schedule_time_relations(self, t: float, g: np.ndarray, dgdt: np.ndarray) -> None:
         """Next instant where a relation on time alone changes value."""

@@ -110,6 +110,11 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
                                  "must be a positive finite number", 0.0)
         self.tables = [(t, nb + t.c0, nb + t.c1) for t in hyb.tables]
         self.cond_pre = np.zeros(0)
+        #: per relation: how far past zero its indicator must go to change it between events
+        self.hysteresis = np.zeros(len(self.fn.relations))
+        nz = dae.z.numel()
+        self._on_z = np.array([bool(nz and ca.depends_on(r.indicator, dae.z))
+                               for r in self.fn.relations], dtype=bool)
         self._time_next = math.inf
         self._time_cause = ""
         self._stretch = math.inf        # longest stretch to integrate at once [s]
@@ -247,8 +252,7 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         if fn.state_rel:
             G = np.asarray(self._ind_map(last)(ts.reshape(1, -1), X, Z, self.p))
             frozen = self.p[fn.rel_slot[fn.state_rel]].astype(bool)
-            now = self._values(G, fn.strict[fn.state_rel])
-            cols = np.nonzero((now != frozen[:, None]).any(axis=0))[0]
+            cols = np.nonzero(self._crossed(G, frozen).any(axis=0))[0]
             if cols.size:
                 j = int(cols[0])
                 last = j
@@ -416,12 +420,14 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
                    if is_sample_instant(start, interval, t)]
         if cause == "terminal":
             self.p[self.dae.n_base + self.dae.hybrid.terminal] = 1.0
-        x, z, out = self._iterate(t, x, z, samples)
+        before = (out[0], self.p[self.fn.rel_slot].copy())
+        x, z, out = self._iterate(t, x, z, samples, before)
         return x, z, left, out[6][self.obs_idx]
 
-    def _iterate(self, t: float, x, z, samples: list[int]):
+    def _iterate(self, t: float, x, z, samples: list[int], before=None):
         """Event iteration to a fixed point of the discrete equations; returns (x, z) and the
-        step outputs at the converged point."""
+        step outputs at the converged point. ``before``: the indicators and relation values
+        before the event."""
         fn = self.fn
         dae = self.dae
         nb = dae.n_base
@@ -495,7 +501,23 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
             self.cond_pre = out[2]
             self._set_pre_from(out)
         self._schedule_time_relations(t, out[0], out[1])
+        self._keep_settled(t, out[0], out[1], before)
         return x, z, out
+
+    def _keep_settled(self, t: float, g: np.ndarray, dgdt: np.ndarray, before) -> None:
+        """Relations on algebraic variables at rounding level change again only once their
+        indicator is past the tolerance: one left against the sign of its indicator (settled
+        within the tolerance), and one whose crossing vanished when the algebraic variables
+        were solved again at the event (the integrator's algebraic error made it)."""
+        fn = self.fn
+        value = self.p[fn.rel_slot]
+        tol = self.opts.relation_tol
+        keep = self._relation_values(t, g, dgdt) != value
+        if before is not None:
+            g_left, frozen = before
+            vanished = (self._relation_values(t, g_left, dgdt) != frozen) & (value == frozen)
+            keep |= vanished & (np.abs(g) <= tol) & (np.abs(g_left) <= tol)
+        self.hysteresis = np.where(keep & self._on_z, tol, 0.0)
 
     def _settle(self, t: float, x, cycle: _Cycle) -> np.ndarray:
         """Relation values of a mixed system whose event iteration cycles (see
