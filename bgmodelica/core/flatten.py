@@ -123,6 +123,9 @@ class _Flattener(ConnectionLowering):
         self._connection_equations()
         self._component_equations()
         initial = self._initial_equations()
+        for sym, fv in self.collected:     # initial equations may give values and starts
+            if fv.decl is not sym.decl:
+                fv.decl = sym.decl
         sources = self._sources(parameters)
         self._check_cycles(parameters)
         parameters = [p if type(p.decl.value) is float else self._lower_binding(p)

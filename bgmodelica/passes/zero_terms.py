@@ -29,6 +29,9 @@ def evaluate_zero_terms(model: FlatModel) -> tuple[FlatModel, dict[str, float]]:
     (the model itself and {} when there are none)."""
     zero_params = [p for p, v in zip(model.parameters, parameter_defaults(model), strict=True)
                    if v == 0.0]
+    if zero_params and model.initial_equations:     # their value may be found there
+        held = ca.vertcat(*[eq.residual for eq in model.initial_equations])
+        zero_params = [p for p in zero_params if not ca.depends_on(held, p.sx)]
     if not zero_params or not model.equations:
         return model, {}
     state = _Zeros(model, zero_params)

@@ -476,7 +476,7 @@ def _store(ref: Any, value: Any, ctx: Ctx, node: Any) -> None:
         raise fail(ctx.lex, node, f"assignment to {name!r}, which is not a variable of the "
                    "function")
     if not subs:
-        ctx.loops[name] = copy.deepcopy(value) if isinstance(value, list) else value
+        ctx.loops[name] = _copy_lists(value)
         return
     cur = ctx.loops[name]
     num = Ctx(ctx.env, ctx.lex, ctx.loops, False)
@@ -490,6 +490,12 @@ def _store(ref: Any, value: Any, ctx: Ctx, node: Any) -> None:
             raise fail(ctx.lex, node, f"subscript of {name} depends on time-varying values")
         idx.append(v)
     ctx.loops[name] = _set(cur, idx, value, ctx, node, name)
+
+
+def _copy_lists(value: Any) -> Any:
+    """``value`` with its (nested) lists copied and their elements shared: expressions
+    are never changed in place, and copying one would copy the variables it names."""
+    return [_copy_lists(v) for v in value] if isinstance(value, list) else value
 
 
 def _set(cur: Any, idx: list, value: Any, ctx: Ctx, node: Any, name: str) -> Any:
