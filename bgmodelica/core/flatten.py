@@ -381,6 +381,9 @@ class _Flattener(ConnectionLowering):
                 try:
                     key = (_side_shape(eq.lhs, leaves, consts),
                            _side_shape(eq.rhs, leaves, consts))
+                except RecursionError:           # too deep to group: lowered alone
+                    slow.append((to_sx(eq.lhs) - to_sx(eq.rhs), where))
+                    continue
                 except TypeError:
                     if isinstance(eq.lhs, (ca.SX, ca.MX)) or isinstance(eq.rhs, (ca.SX, ca.MX)):
                         slow.append((to_sx(eq.lhs) - to_sx(eq.rhs), where))
