@@ -256,7 +256,8 @@ def _compile_cached(model: Component, units: str, cache: bool | str | Path) -> C
     return compiled
 
 
-def _compile(model: Component, select: Selector | None, units: str = "error") -> CompiledModel:
+def _compile(model: Component, select: Selector | None, units: str = "error",
+             zero_terms: bool = True) -> CompiledModel:
     if not isinstance(model, Component):
         raise DeclarationError(
             f"compile() expects a Component instance, got {type(model).__name__}")
@@ -274,7 +275,7 @@ def _compile(model: Component, select: Selector | None, units: str = "error") ->
     flat = eliminate_aliases(flat)
     flat.asserts = raw.asserts
     lap("alias")
-    flat, evaluated = evaluate_zero_terms(flat)
+    flat, evaluated = evaluate_zero_terms(flat) if zero_terms else (flat, {})
     lap("zero_terms")
     try:
         balance = check_balance(flat)

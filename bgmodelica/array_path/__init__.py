@@ -138,7 +138,7 @@ class ArrayCompiledModel(CompiledModel):
         self = object.__new__(cls)
         self.__dict__.update(name=name, dae=dae, n_flat_equations=n_equations,
                              timings=timings, source=source, _units=units,
-                             _variables=variables, _names=names)
+                             _variables=variables, _names=names, evaluated={})
         return self
 
     def __getattr__(self, attr: str) -> Any:
@@ -157,7 +157,8 @@ class ArrayCompiledModel(CompiledModel):
                                "the array path need its source component")
         t0 = _time.perf_counter()
         with gc_paused():
-            full = _compile(self.source, None, self.__dict__.get("_units", "error"))
+            full = _compile(self.source, None, self.__dict__.get("_units", "error"),
+                            zero_terms=False)    # the array path keeps every parameter
         mine, theirs = self.dae, full.dae
         if (mine.names != theirs.names or mine.state_names != theirs.state_names
                 or [q.name for q in mine.parameters] != [q.name for q in theirs.parameters]

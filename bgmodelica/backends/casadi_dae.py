@@ -99,6 +99,12 @@ class CasadiDAE:
         return out
 
     @property
+    def initial_parameters(self) -> list[int]:
+        """Positions in ``p`` of the parameters the initial equations determine (declared
+        ``fixed=False``): unknowns of the initialization, constant afterwards."""
+        return [k for k, q in enumerate(self.parameters) if not getattr(q.decl, "fixed", True)]
+
+    @property
     def n_base(self) -> int:
         """Index of the first discrete slot in ``p`` (parameters and inputs come first)."""
         return len(self.parameters) + len(self.inputs)

@@ -22,9 +22,13 @@ from .casadi_dae import CasadiDAE
 
 @dataclass
 class InitialValues:
+    """Consistent initial states and algebraic variables; ``p``: the parameter vector with
+    the parameters the initial equations determine (``fixed=False``) solved."""
+
     x0: np.ndarray
     z0: np.ndarray
     notes: list[str] = field(default_factory=list)
+    p: np.ndarray | None = None
 
 
 @dataclass
@@ -35,7 +39,8 @@ class InitStructure:
     with z from ``conditions`` ``(observed index, value)`` and the model's ``n_initial``
     initial equations (``dae.initial``, rows ``initial_rows``; all when None); notes:
     states left at their start values; surplus: conditions beyond those that determine the
-    states (residual expression, label, value), to hold at the solution (else ``surplus_error``)."""
+    states (residual expression, label, value), to hold at the solution (else ``surplus_error``);
+    params: positions in ``p`` of the parameters solved with them (``fixed=False``)."""
 
     x0: np.ndarray
     free: list[int]
@@ -45,6 +50,12 @@ class InitStructure:
     initial_rows: list[int] | None = None
     surplus: list[tuple[ca.SX, str, float]] = field(default_factory=list)
     surplus_error: str = ""
+    params: list[int] = field(default_factory=list)
+
+    def known_params(self, n_p: int) -> list[int]:
+        """Positions in ``p`` of the parameters that are inputs of the initialization."""
+        solved = set(self.params)
+        return [k for k in range(n_p) if k not in solved]
 
     def rows(self) -> list[int]:
         """The initial equations used to solve for the states."""
@@ -80,12 +91,14 @@ def init_structure(dae: CasadiDAE) -> InitStructure:
     n_init = _n_initial(dae)
     st = InitStructure(x0, [], conditions, [], n_init)
     free = [i for i in range(len(x0)) if i not in fixed_states]
+    params = dae.initial_parameters if n_init else []
     nz = dae.z.numel()
     exprs = [dae.observed[k] for k, _ in conditions] + [dae.initial[i] for i in range(n_init)]
     if exprs:
         xf = ca.vertcat(*[dae.x[i] for i in free]) if free else ca.SX(0, 1)
-        sp = ca.jacobian_sparsity(ca.vertcat(dae.alg, *exprs),
-                                  ca.vertcat(xf, dae.z)) if free or nz else None
+        pf = ca.vertcat(*[dae.p[k] for k in params]) if params else ca.SX(0, 1)
+        sp = ca.jacobian_sparsity(ca.vertcat(_alg(dae), *exprs),
+                                  ca.vertcat(xf, dae.z, pf)) if free or nz or params else None
         rows: list[list[int]] = [[] for _ in range(nz + len(exprs))]
         if sp is not None:
             for r, c in zip(*sp.get_triplet(), strict=True):
@@ -93,9 +106,10 @@ def init_structure(dae: CasadiDAE) -> InitStructure:
         # the model's own equations first, on the algebraic variables they determine (so
         # that every algebraic variable stays matched): conditions compete for the rest
         nf = len(free)
-        first = maximum_matching([[c for c in r if c >= nf] for r in rows[:nz]]
-                                 + [[] for _ in exprs], nf + nz)
-        match = maximum_matching(rows, nf + nz, initial=first)
+        n_cols = nf + nz + len(params)
+        first = maximum_matching([[c for c in r if nf <= c < nf + nz] for r in rows[:nz]]
+                                 + [[] for _ in exprs], n_cols)
+        match = maximum_matching(rows, n_cols, initial=first)
         surplus = [i for i in range(len(exprs)) if match.eq_to_var[nz + i] < 0]
         if surplus:          # kept aside: to hold at the solution of the others
             labelled = list(zip(exprs, st.labels(dae), strict=True))
@@ -107,8 +121,13 @@ def init_structure(dae: CasadiDAE) -> InitStructure:
             st.conditions = [c for i, c in enumerate(conditions) if i not in surplus]
             st.initial_rows = [i for i in range(n_init) if nc + i not in surplus]
         unmatched = [free[c] for c in range(nf) if match.var_to_eq[c] < 0]
+        st.params = [k for c, k in enumerate(params) if match.var_to_eq[nf + nz + c] >= 0]
     else:
         unmatched = list(free)
+    if len(st.params) < len(params):
+        names = [dae.parameters[k].name for k in params if k not in set(st.params)]
+        st.notes.append("no initial equation determines parameter(s) " + ", ".join(names)
+                        + " (fixed=false); their start values were used")
     if unmatched:
         st.notes.append("no fixed start value or initial equation for state(s) "
                         + ", ".join(dae.state_names[i] for i in unmatched)
@@ -119,15 +138,22 @@ def init_structure(dae: CasadiDAE) -> InitStructure:
 
 
 def _init_residual(dae: CasadiDAE, st: InitStructure) -> ca.Function:
-    """``g(w, [x_pinned, p, t])``: conditions, initial equations and algebraic equations,
-    w = [x_free, z]."""
-    unknown = ca.vertcat(*[dae.x[i] for i in st.free], dae.z)
+    """``g(w, [x_pinned, p_known, t])``: conditions, initial equations and algebraic
+    equations, w = [x_free, z, p_solved] (``st.params``, ``st.known_params``)."""
+    unknown = ca.vertcat(*[dae.x[i] for i in st.free], dae.z, *[dae.p[k] for k in st.params])
     cond = [dae.observed[k] - v for k, v in st.conditions] \
         + [dae.initial[i] for i in st.rows()]
     pinned = [i for i in range(len(st.x0)) if i not in set(st.free)]
     known = ca.vertcat(*[dae.x[i] for i in pinned]) if pinned else ca.SX(0, 1)
-    return ca.Function("init_g", [unknown, ca.vertcat(known, dae.p, dae.t)],
-                       [ca.vertcat(*cond, dae.alg)])
+    p_known = dae.p if not st.params else \
+        ca.vertcat(*[dae.p[k] for k in st.known_params(dae.p.numel())])
+    return ca.Function("init_g", [unknown, ca.vertcat(known, p_known, dae.t)],
+                       [ca.vertcat(*cond, _alg(dae))])
+
+
+def _alg(dae: CasadiDAE) -> ca.SX:
+    """The algebraic equations as a column (an empty one without algebraic variables)."""
+    return dae.alg if dae.alg.numel() else ca.SX(0, 1)
 
 
 def initial_state_function(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
@@ -145,8 +171,10 @@ def initial_state_function(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
     pinned = [i for i in range(len(st.x0)) if i not in set(st.free)]
     t = ca.MX.sym("t")
     pm = ca.MX.sym("p", dae.p.numel())
-    guess = np.concatenate([sol.x0[st.free], sol.z0])
-    w = solver(ca.DM(guess), ca.vertcat(ca.DM(st.x0[pinned]), pm, t))
+    guess = np.concatenate([sol.x0[st.free], sol.z0, sol.p[st.params]])
+    known = st.known_params(dae.p.numel())
+    w = solver(ca.DM(guess), ca.vertcat(ca.DM(st.x0[pinned]),
+                                        pm[known] if st.params else pm, t))
     parts = [None] * len(st.x0)
     for k, i in enumerate(st.free):
         parts[i] = w[k]
@@ -163,24 +191,31 @@ def initialize(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
     (``dae.initial``, Modelica ``initial equation``), together with the algebraic equations;
     they must determine the states independently (balance checked by a matching: conditions
     left unmatched raise :class:`InitializationError` naming them and the variables they
-    compete for); states without a condition keep their start values (a note)."""
+    compete for); states without a condition keep their start values (a note). Parameters
+    declared ``fixed=False`` are solved with them, their values in ``p`` the guesses: ``p``
+    is updated in place with the solution (also in the result's ``p``)."""
     st = init_structure(dae)
     x0, free = st.x0, st.free
     z0 = dae.z_start.copy()
     n_cond = len(st.conditions) + len(st.rows())
     if not n_cond and dae.z.numel() == 0:
-        return _surplus_checked(dae, st, p, t0, InitialValues(x0, z0, list(st.notes)))
-    guess = np.concatenate([x0[free], z0])
+        return _surplus_checked(dae, st, p, t0, InitialValues(x0, z0, list(st.notes), p))
+    p = np.asarray(p, dtype=float)
+    guess = np.concatenate([x0[free], z0, p[st.params]])
     pinned = [i for i in range(len(x0)) if i not in set(free)]
     g = _init_residual(dae, st)
-    args = np.concatenate([x0[pinned], p, [t0]])
+    known = p[st.known_params(len(p))] if st.params else p
+    args = np.concatenate([x0[pinned], known, [t0]])
     r0 = np.asarray(g(guess, args)).ravel()
     if r0.size and np.max(np.abs(r0)) > tol:
         solver = ca.rootfinder("init", "newton", g, {"abstol": tol, "max_iter": 100,
                                                      "error_on_fail": False})
         sol = np.asarray(solver(guess, args)).ravel()
         r1 = np.asarray(g(sol, args)).ravel()
-        if not np.all(np.isfinite(r1)) or np.max(np.abs(r1)) > max(1e3 * tol, 1e-8):
+        ok = _converged(r1, tol)
+        if not ok:
+            sol, r1, ok = _trust_region(g, guess, args, sol, r1, tol)
+        if not ok:
             with np.errstate(invalid="ignore"):
                 worst = int(np.argmax(np.where(np.isfinite(r1), np.abs(r1), np.inf)))
             labels = st.labels(dae)
@@ -195,8 +230,50 @@ def initialize(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
                 + hint)
         guess = sol
     x0[free] = guess[:len(free)]
-    z0 = guess[len(free):]
-    return _surplus_checked(dae, st, p, t0, InitialValues(x0, z0, list(st.notes)))
+    z0 = guess[len(free):len(guess) - len(st.params)]
+    if st.params:
+        p[st.params] = guess[len(guess) - len(st.params):]
+    return _surplus_checked(dae, st, p, t0, InitialValues(x0, z0, list(st.notes), p))
+
+
+def _converged(r: np.ndarray, tol: float) -> bool:
+    return bool(np.all(np.isfinite(r)) and np.max(np.abs(r), initial=0.0) <= max(1e3 * tol, 1e-8))
+
+
+#: largest initialization problem the trust-region fallback takes on (it is dense)
+TRUST_REGION_SIZE = 400
+
+
+def _trust_region(g: ca.Function, guess: np.ndarray, args: np.ndarray, sol: np.ndarray,
+                  r1: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray, bool]:
+    """A second attempt when Newton's method failed (implicit equations far from their
+    start values, e.g. time constants of 1e-5 s): Powell's trust-region method on the
+    unknowns scaled by their start values and the residuals by their Jacobian rows at the
+    start. Returns the better solution, its residual and whether it converged (judged on
+    the scaled residuals)."""
+    if not 0 < guess.size <= TRUST_REGION_SIZE:
+        return sol, r1, False
+    from scipy.optimize import root
+
+    scale = np.where(np.abs(guess) > 0, np.abs(guess), 1.0)
+    jac = g.factory("init_jac", ["i0", "i1"], ["jac:o0:i0"])
+    with np.errstate(all="ignore"):
+        j0 = np.abs(np.asarray(jac(guess, args)) * scale).max(axis=1)
+    rows = np.where(np.isfinite(j0) & (j0 > 0), 1.0 / j0, 1.0)
+
+    def residual(y: np.ndarray) -> np.ndarray:
+        return np.asarray(g(y * scale, args)).ravel() * rows
+
+    def jacobian(y: np.ndarray) -> np.ndarray:
+        return np.asarray(jac(y * scale, args)) * scale * rows[:, None]
+
+    with np.errstate(all="ignore"):
+        out = root(residual, guess / scale, jac=jacobian, method="hybr")
+        found = out.x * scale
+        r2 = np.asarray(g(found, args)).ravel()
+    if _converged(r2 * rows, tol) and np.all(np.isfinite(r2)):
+        return found, r2, True
+    return sol, r1, False
 
 
 def _surplus_checked(dae: CasadiDAE, st: InitStructure, p: np.ndarray, t0: float,

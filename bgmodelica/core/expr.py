@@ -259,24 +259,27 @@ def to_sx(e: Any, leaf_sx: Callable[[Any], ca.SX] | None = None) -> Any:
 def lower_tree(e: Any, leaf: Callable[[Any], Any]) -> Any:
     """An expression tree as CasADi operations on what ``leaf(symbol)`` gives for its leaves
     (SX or MX); shared subtrees are lowered once, numbers stay floats."""
+    if isinstance(e, (float, int)):
+        return float(e)
     memo: dict[int, Any] = {}
-
-    def go(node: Any) -> Any:
-        if isinstance(node, (float, int)):
-            return float(node)
+    stack = [(e, False)]
+    while stack:                     # post-order without recursion (deep sums and tables)
+        node, ready = stack.pop()
         key = id(node)
         if key in memo:
-            return memo[key]
+            continue
         if isinstance(node, Leaf):
-            out = leaf(node.sym)
-        elif isinstance(node, Expr):
-            out = apply_op(node.op, [go(a) for a in node.args])
+            memo[key] = leaf(node.sym)
+        elif not isinstance(node, Expr):
+            memo[key] = ca.SX(node)
+        elif not ready:
+            stack.append((node, True))
+            stack.extend((a, False) for a in reversed(node.args)
+                         if not isinstance(a, (float, int)) and id(a) not in memo)
         else:
-            out = ca.SX(node)
-        memo[key] = out
-        return out
-
-    return go(e)
+            memo[key] = apply_op(node.op, [float(a) if isinstance(a, (float, int))
+                                           else memo[id(a)] for a in node.args])
+    return memo[id(e)]
 
 
 def shape_of(e: Any, leaves: list, consts: list) -> Any:

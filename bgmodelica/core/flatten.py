@@ -125,6 +125,9 @@ class _Flattener(ConnectionLowering):
         self._connection_equations()
         self._component_equations()
         initial = self._initial_equations()
+        for sym, fv in self.collected:     # initial equations may give values and starts
+            if fv.decl is not sym.decl:
+                fv.decl = sym.decl
         sources = self._sources(parameters)
         self._check_cycles(parameters)
         parameters = [p if type(p.decl.value) is float else self._lower_binding(p)
@@ -381,6 +384,9 @@ class _Flattener(ConnectionLowering):
                 try:
                     key = (_side_shape(eq.lhs, leaves, consts),
                            _side_shape(eq.rhs, leaves, consts))
+                except RecursionError:           # too deep to group: lowered alone
+                    slow.append((to_sx(eq.lhs) - to_sx(eq.rhs), where))
+                    continue
                 except TypeError:
                     if isinstance(eq.lhs, (ca.SX, ca.MX)) or isinstance(eq.rhs, (ca.SX, ca.MX)):
                         slow.append((to_sx(eq.lhs) - to_sx(eq.rhs), where))

@@ -160,33 +160,49 @@ class _Rewriter:
         return self._walk(e, here, live=True, rewrite=True)
 
     def _walk(self, e: Any, here: str, live: bool, rewrite: bool) -> Any:
+        """``e`` with its live relations (outside ``noEvent``, on continuous values) replaced
+        by relation slots when ``rewrite``; iterative (long expressions, such as a table's
+        chain of ``if_else``, are deeper than Python's recursion limit)."""
         if not isinstance(e, Expr):
             return e
-        key = (id(e), live and rewrite)
-        if key in self.memo:
-            return self.memo[key]
-        if isinstance(e, Leaf):
-            self._note(e.sym)
-            out: Any = e
-        elif e.op == "noEvent":
-            out = Op("noEvent", (self._walk(e.args[0], here, False, rewrite),))
-        elif e.op in RELATIONS and live and rewrite and (_continuous(e.args[0])
-                                                          or _continuous(e.args[1])):
-            a = self._walk(e.args[0], here, live, rewrite)
-            b = self._walk(e.args[1], here, live, rewrite)
+        memo = self.memo
+        stack = [(e, live, False)]
+        while stack:
+            node, lv, ready = stack.pop()
+            key = (id(node), lv and rewrite)
+            if key in memo:
+                continue
+            if isinstance(node, Leaf):
+                self._note(node.sym)
+                memo[key] = node
+                continue
+            inner = False if node.op == "noEvent" else lv
+            if not ready:
+                stack.append((node, lv, True))
+                stack.extend((a, inner, False) for a in reversed(node.args)
+                             if isinstance(a, Expr) and (id(a), inner and rewrite) not in memo)
+                continue
+            args = tuple(memo[(id(a), inner and rewrite)] if isinstance(a, Expr) else a
+                         for a in node.args)
+            memo[key] = self._rebuilt(node, args, here, lv and rewrite)
+        return memo[(id(e), live and rewrite)]
+
+    def _rebuilt(self, e: Op, args: tuple, here: str, live: bool) -> Any:
+        """``e`` over its walked ``args``: a relation slot for a live relation."""
+        if e.op == "noEvent":
+            return Op("noEvent", args)
+        if e.op in RELATIONS and live and (_continuous(e.args[0]) or _continuous(e.args[1])):
+            a, b = args
             rk = (e.op, id(a), id(b))
             slot = self.rel_memo.get(rk)
             if slot is None:
                 slot = RelationSlot(e.op, a, b, here)
                 self.rel_memo[rk] = slot
                 self.draft.relations.append(slot)
-            out = slot.leaf
-        else:
-            args = tuple(self._walk(a, here, live, rewrite) for a in e.args)
-            out = e if all(x is y for x, y in zip(args, e.args, strict=True)) \
-                else Op(e.op, args)
-        self.memo[key] = out
-        return out
+            return slot.leaf
+        if all(x is y for x, y in zip(args, e.args, strict=True)):
+            return e
+        return Op(e.op, args)
 
     def _note(self, sym: Any) -> None:
         if isinstance(sym, (SampleClock, TimeTable)) or sym is _INITIAL or sym is _TERMINAL:
@@ -200,14 +216,19 @@ class _Rewriter:
 
 def _continuous(e: Any) -> bool:
     """Whether ``e`` depends on time or a continuous-time variable."""
-    if isinstance(e, Leaf):
-        sym = e.sym
-        if sym is TIME:
-            return True
-        decl = getattr(sym, "decl", None)
-        return decl is not None and decl.kind != KIND_PARAMETER and not sym.is_discrete
-    if isinstance(e, Op):
-        return any(_continuous(a) for a in e.args)
+    stack, seen = [e], set()
+    while stack:
+        x = stack.pop()
+        if isinstance(x, Leaf):
+            sym = x.sym
+            if sym is TIME:
+                return True
+            decl = getattr(sym, "decl", None)
+            if decl is not None and decl.kind != KIND_PARAMETER and not sym.is_discrete:
+                return True
+        elif isinstance(x, Op) and id(x) not in seen:
+            seen.add(id(x))
+            stack.extend(x.args)
     return False
 
 

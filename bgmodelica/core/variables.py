@@ -73,11 +73,14 @@ class Parameter(Declaration):
     """A constant of the model, tunable between simulations without recompiling.
 
     value: default value, a number or an expression of other parameters.
+    fixed: False for a parameter the initial equations determine (Modelica ``fixed=false``):
+    an unknown of the initialization, ``value`` its guess, constant afterwards.
     """
 
     value: Any = 0.0
     min: float | None = None
     max: float | None = None
+    fixed: bool = True
     kind = KIND_PARAMETER
 
     def with_start(self, value: Any) -> Parameter:

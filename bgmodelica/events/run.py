@@ -42,7 +42,7 @@ def simulate_hybrid(compiled, dae: CasadiDAE, p: np.ndarray, grid: np.ndarray, *
     units = {v.name: v.decl.unit for v in flat.variables}
     units.update({d.name: d.decl.unit for d in flat.discretes})
     units.update({q.name: q.decl.unit for q in (*flat.parameters, *flat.inputs)})
-    params_out = dae.parameter_values(p)
+    params_out = dae.parameter_values(sim.p)     # with those initialization solved
     meta = {"model": compiled.name, "compile_seconds": compiled.compile_time,
             "run_seconds": _time.perf_counter() - t_start,
             "timings": dict(compiled.timings), "solver": "cvodes" if not dae.z.numel()

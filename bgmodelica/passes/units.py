@@ -272,61 +272,89 @@ class _Checker:
         return out
 
     def infer(self, e: Any) -> Any:
+        """The unit value of expression ``e``; iterative, each shared subexpression once
+        (long sums and tables are deeper than Python's recursion limit)."""
+        if not _is_op(e):
+            return self._atom(e)
+        memo: dict[int, Any] = {}
+        stack = [(e, False)]
+        while stack:
+            node, ready = stack.pop()
+            if id(node) in memo:
+                continue
+            if not ready:
+                stack.append((node, True))
+                stack.extend((a, False) for a in reversed(node.args)
+                             if _is_op(a) and id(a) not in memo)
+                continue
+            values = [memo[id(a)] if _is_op(a) else self._atom(a) for a in node.args]
+            memo[id(node)] = self._apply(node, values)
+        return memo[id(e)]
+
+    def _atom(self, e: Any) -> Any:
         if isinstance(e, Leaf):
             return self.value(_leaf_key(e.sym), e.sym)
         if isinstance(e, Number) or isinstance(e, bool):
             return LIT
-        if not isinstance(e, Expr):
-            return FREE                       # CasADi SX inside an equation: not checked
+        return FREE                           # CasADi SX inside an equation: not checked
+
+    def _apply(self, e: Any, v: list) -> Any:
+        """The unit value of operation ``e`` on its arguments' unit values ``v``."""
         op, args = e.op, e.args
         if op in ("+", "-"):
-            a, b = self.infer(args[0]), self.infer(args[1])
+            a, b = v[0], v[1]
             verb = "add" if op == "+" else "subtract"
             return combine(a, b, f"cannot {verb} {{0}} and {{1}}")
         if op == "*":
-            return mul(self.infer(args[0]), self.infer(args[1]))
+            return mul(v[0], v[1])
         if op == "/":
-            return div(self.infer(args[0]), self.infer(args[1]))
+            return div(v[0], v[1])
         if op in _SAME:
-            return self.infer(args[0])
+            return v[0]
         if op in _TRANSCENDENTAL:
-            a = self.infer(args[0])
+            a = v[0]
             dimensionless(a, f"{op}()")
             return LIT if a is LIT else DIMLESS
         if op == "sqrt":
-            return power(self.infer(args[0]), 0.5)
+            return power(v[0], 0.5)
         if op == "**":
-            base = self.infer(args[0])
+            base = v[0]
             if isinstance(args[1], float):
                 return power(base, args[1])
-            p = self.infer(args[1])
+            p = v[1]
             dimensionless(p, "an exponent")
             if isinstance(base, Adaptive):
                 return base
             dimensionless(base, "a power with a variable exponent")
             return DIMLESS
         if op in _COMPARE:
-            combine(self.infer(args[0]), self.infer(args[1]), "cannot compare {0} and {1}")
+            combine(v[0], v[1], "cannot compare {0} and {1}")
             return DIMLESS
         if op in _LOGIC:
-            for a in args:
-                dimensionless(self.infer(a), f"'{op}'")
+            for a in v:
+                dimensionless(a, f"'{op}'")
             return DIMLESS
         if op == "sign":
-            self.infer(args[0])
+            v[0]
             return DIMLESS
         if op == "atan2":
-            combine(self.infer(args[0]), self.infer(args[1]),
+            combine(v[0], v[1],
                      "atan2() needs arguments in one unit, got {0} and {1}")
             return DIMLESS
         if op in ("fmin", "fmax"):
-            return combine(self.infer(args[0]), self.infer(args[1]),
+            return combine(v[0], v[1],
                             f"{op}() needs arguments in one unit, got {{0}} and {{1}}")
         if op == "if_else":
-            dimensionless(self.infer(args[0]), "an if_else condition")
-            return combine(self.infer(args[1]), self.infer(args[2]),
+            dimensionless(v[0], "an if_else condition")
+            return combine(v[1], v[2],
                             "if_else branches differ: {0} and {1}")
         return FREE                           # an operation this check does not know
+
+
+
+
+def _is_op(e: Any) -> bool:
+    return isinstance(e, Expr) and not isinstance(e, Leaf)
 
 
 def _leaf_key(sym: Any) -> Any:

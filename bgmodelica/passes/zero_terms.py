@@ -18,6 +18,7 @@ from collections.abc import Callable
 from dataclasses import replace
 
 import casadi as ca
+import numpy as np
 
 from ..core.flatmodel import FlatEquation, FlatModel, FlatVariable
 from .symbolic import incidence, model_incidence
@@ -29,6 +30,9 @@ def evaluate_zero_terms(model: FlatModel) -> tuple[FlatModel, dict[str, float]]:
     (the model itself and {} when there are none)."""
     zero_params = [p for p, v in zip(model.parameters, parameter_defaults(model), strict=True)
                    if v == 0.0]
+    if zero_params and model.initial_equations:     # their value may be found there
+        held = ca.vertcat(*[eq.residual for eq in model.initial_equations])
+        zero_params = [p for p in zero_params if not ca.depends_on(held, p.sx)]
     if not zero_params or not model.equations:
         return model, {}
     state = _Zeros(model, zero_params)
@@ -107,6 +111,8 @@ class _Zeros:
             return [], None
         before = self._vars(res)
         full = _put_zero(res, zeros)
+        if not _finite(full):                     # a zero divides: the model's error
+            return [], None
         after = self._vars(full)
         sets_zero = len(before) > 1 and self._zero_variable(full) is not None
         if not after or not (before - after - set(self.zero_vars) or sets_zero):
@@ -146,6 +152,18 @@ class _Zeros:
         if not (slope.is_constant() and float(slope) != 0.0 and rest.is_zero()):
             return None
         return j
+
+
+def _finite(res: ca.SX) -> bool:
+    """Whether ``res`` is finite at a point of its symbols in [0.5, 1.5] (a zero put into a
+    denominator leaves an infinite constant)."""
+    syms = ca.symvar(res)
+    if not syms:
+        return bool(np.isfinite(float(ca.evalf(res))))
+    point = np.random.default_rng(0).uniform(0.5, 1.5, len(syms))
+    with np.errstate(all="ignore"):
+        value = float(ca.Function("zero_terms_check", [ca.vertcat(*syms)], [res])(point))
+    return bool(np.isfinite(value))
 
 
 def _users(rows: list[list[int]], n_vars: int) -> list[list[int]]:

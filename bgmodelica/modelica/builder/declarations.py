@@ -93,6 +93,8 @@ def _make_decl(info: ElemInfo, tref: TypeRef, attrs: dict, value: Any, connector
             value = float(value.index)
         elif _is_number(value):
             value = float(value)
+        if "fixed" in attrs and not attrs["fixed"]:
+            kw["fixed"] = False
         return Parameter(value=value, **kw)
     start = attrs.get("start")
     if start is not None:

@@ -162,7 +162,7 @@ def _parameter_value(a: Any, b: Any, ctx: Ctx, node: Any) -> bool:
     for x, y in found:
         sym = getattr(x, "sym", None) if isinstance(x, Expr) else None
         decl = getattr(sym, "decl", None)
-        if decl is None or decl.kind != KIND_PARAMETER:
+        if decl is None or decl.kind != KIND_PARAMETER or _unsolved(y):
             return False
         try:
             value = numeric_value(y, ctx.lex, node,
@@ -175,9 +175,28 @@ def _parameter_value(a: Any, b: Any, ctx: Ctx, node: Any) -> bool:
             return False
         solved.append((sym, decl, value))
     for sym, decl, value in solved:
-        sym.decl = decl.evolve(value=float(value))
+        sym.decl = decl.evolve(value=float(value), fixed=True)
         _remember(sym, value)
     return bool(solved)
+
+
+def _unsolved(value: Any) -> bool:
+    """Whether ``value`` reads a parameter that initial equations still have to determine
+    (``fixed=false``, not solved when built): its start value is only a guess."""
+    from ...core.expr import Leaf, Op
+
+    stack, seen = [value], set()
+    while stack:
+        e = stack.pop()
+        if isinstance(e, list):
+            stack.extend(e)
+        elif isinstance(e, Leaf):
+            if getattr(getattr(e.sym, "decl", None), "fixed", True) is False:
+                return True
+        elif isinstance(e, Op) and id(e) not in seen:
+            seen.add(id(e))
+            stack.extend(e.args)
+    return False
 
 
 def _remember(sym: Any, value: float) -> None:
