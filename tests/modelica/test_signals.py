@@ -207,5 +207,6 @@ equation
   x[3] = 0;
 end Loop;
 """
-    with pytest.raises(ModelicaError, match=r"<string>:6:\d+: cannot evaluate when the model is built: k is a variable"):
+    with pytest.raises(ModelicaError, match=r"<string>:6:\d+: cannot evaluate when the model "
+                                            r"is built: k is a variable"):
         bg.compile(load_modelica_text(text, "Loop"))
