@@ -20,7 +20,7 @@ class Env:
     Python element once created, and memoized values of its parameters."""
 
     __slots__ = ("view", "mods", "parent", "inst", "path", "_num", "_emod", "disabled",
-                 "_busy", "cached", "pending")
+                 "_busy", "cached", "pending", "buses")
 
     def __init__(self, view: ClassView, mods: dict[str, Mod], parent: Env | None,
                  path: str) -> None:
@@ -36,6 +36,8 @@ class Env:
         self.cached: tuple | None = None
         #: declaration equations of the instances below, evaluated once all are built
         self.pending: list[tuple] = []
+        #: the expandable connectors built below (at the root)
+        self.buses: list[Element] = []
 
     def emod(self, name: str) -> Mod | None:
         """The merged modification of element ``name``: the outer one on top of the

@@ -25,6 +25,7 @@ from .base import (
 )
 from .env import Env
 from .evaluate import _iterate, evaluate
+from .expandable import Missing, connect_bus, connect_end, resolve
 from .types import check_condition
 
 
@@ -254,8 +255,10 @@ def _eval_call_equation(eq: A.EqCall, ctx: Ctx, out: list, initial: bool) -> Non
     if name == "connect":
         if len(call.args) != 2 or call.kwargs:
             raise fail(ctx.lex, eq, "connect(a, b) takes two connectors")
-        a = evaluate(call.args[0], ctx)
-        b = evaluate(call.args[1], ctx)
+        a = connect_end(call.args[0], ctx, evaluate)
+        b = connect_end(call.args[1], ctx, evaluate)
+        if isinstance(a, Missing) or isinstance(b, Missing):
+            a, b = resolve(a, b, ctx, eq)
         _connect(a, b, ctx, eq, out)
         return
     if name == "assert":
@@ -327,6 +330,8 @@ def _connect(a: Any, b: Any, ctx: Ctx, node: Any, out: list) -> None:
             raise fail(ctx.lex, node, "connect() of arrays of different sizes")
         for x, y in zip(a, b, strict=True):
             _connect(x, y, ctx, node, out)
+        return
+    if connect_bus(a, b, ctx, node, out):
         return
     if isinstance(a, Connector) and isinstance(b, Connector) and (a._children or b._children):
         _connect_nested(a, b, ctx, node, out)

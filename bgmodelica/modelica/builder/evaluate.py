@@ -22,6 +22,7 @@ from .arith import (
 from .base import Ctx, NotConstant, _Disabled, check_array_size, fail, numeric_value
 from .classes import class_view, type_ref
 from .env import Env, _category, static_env
+from .expandable import Bus, declared_member
 from .types import check_condition, check_number_operands
 
 
@@ -259,6 +260,10 @@ def _member(elem: Element, name: str, numeric: bool, lex: Any, node: Any) -> Any
             val = _assemble(elem, name, arrays[name])
             cache[name] = val
         return numeric_value(val, lex, node) if numeric else val
+    if isinstance(elem, Bus):
+        made = declared_member(elem, name)
+        if made is not None:
+            return made
     where = f"{elem.name or type(elem).__name__}"
     have = [n for n in list(elem._symbols) + list(elem._children) if "[" not in n]
     have += list(arrays or ())

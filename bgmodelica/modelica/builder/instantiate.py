@@ -30,6 +30,7 @@ from .declarations import _elem_name, _indices, _instance_decl, _override, _stat
 from .env import Env, _category, _dims
 from .equations import _declaration_equations, equations_of
 from .evaluate import evaluate
+from .expandable import evaluate_all, make_bus
 from .mods import Mod, _without_redeclare, index_mod, merge, mod_from_ast
 from .templates import EquationTemplate
 
@@ -44,8 +45,6 @@ def _check_supported(view: ClassView, where: S.ClassScope) -> None:
         raise fail(where, view.cdef, f"{view.scope.full_name} is a function, not a model")
     if kind == "package":
         raise fail(where, view.cdef, f"{view.scope.full_name} is a package, not a model")
-    if kind == "expandable connector":
-        raise fail(where, view.cdef, "unsupported Modelica construct: expandable connectors")
     if kind == "operator":
         raise fail(where, view.cdef, "unsupported Modelica construct: operator classes")
 
@@ -57,6 +56,11 @@ def instantiate(view: ClassView, mods: dict[str, Mod], parent: Env | None, path:
         _check_supported(view, where or view.scope)
         view.checked = True
     env = Env(view, mods, parent, path)
+    if view.kind == "expandable connector":
+        if mods:
+            raise fail(where or view.scope, pos, "unsupported Modelica construct: modifiers "
+                       "of an expandable connector")
+        return make_bus(view, env)
     connector = "connector" in view.kind
     for name in mods:
         if name not in view.elements:
@@ -126,6 +130,9 @@ def instantiate(view: ClassView, mods: dict[str, Mod], parent: Env | None, path:
         for args in env.pending:
             _declaration_equations(*args)
         env.pending.clear()
+        if env.buses:
+            view.validated = True
+            evaluate_all(inst, equations_of)
     if not view.validated:
         # evaluate the equations of the first instance of each class now, so that unknown
         # names, bad calls and wrong connects are reported when the model is loaded
