@@ -320,7 +320,10 @@ def _fn_div(node: A.Call, ctx: Ctx) -> Any:
 def _fn_size(node: A.Call, ctx: Ctx) -> Any:
     if ctx.numeric and node.args:
         # the size of a variable array is known when built even if its values are not
-        first = evaluate(node.args[0], Ctx(ctx.env, ctx.lex, ctx.loops, False))
+        try:
+            first = evaluate(node.args[0], ctx)
+        except NotConstant:
+            first = evaluate(node.args[0], Ctx(ctx.env, ctx.lex, ctx.loops, False))
         rest = _args(A.Call(node.func, node.args[1:], node.kwargs, node.pos), ctx, (0, 1),
                      "size")
         args = [first, *rest]
