@@ -53,6 +53,9 @@ def integrator(dae: CasadiDAE, opts: dict, tout: list[float], scaled: bool) -> c
         problem.update(z=dae.z, alg=ca.substitute(dae.alg, dae.t, t_of))
         solver = "idas"
         solver_opts["calc_ic"] = True
+        # algebraic variables follow the states: leave them out of the local error test, whose
+        # absolute tolerance their solve noise (a stiff switch) can exceed on every step
+        solver_opts.setdefault("suppress_algebraic", True)
     F = ca.integrator("segment", solver, problem, 0.0, [float(v) for v in tout], solver_opts)
     if scaled:
         dae.cache[key] = F

@@ -50,7 +50,8 @@ class EventOptions:
     event_tol: time tolerance of state-event location [s] (relative to max(1, |t|));
     zeno_events: consecutive events closer than ``zeno_dt`` that count as chattering;
     relation_tol: an indicator this close to zero may keep either relation value when the
-    event iteration has to search a mixed system (see :mod:`.mixed`)."""
+    event iteration has to search a mixed system (see :mod:`.mixed`); retry_steps: step
+    budget (per output interval) of an integration that is retried shorter if it fails."""
 
     max_iterations: int = 100
     checks: int = 8
@@ -58,6 +59,8 @@ class EventOptions:
     zeno_events: int = 50
     zeno_dt: float = 1e-10
     relation_tol: float = 1e-8
+    #: solver step budget of an integration that is retried on a shorter stretch if it fails
+    retry_steps: int = 5000
 
 
 @dataclass
@@ -93,7 +96,9 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         self._ind_fast = Fast(self.fn.indicators)
         self.n_segments = 0
         self._sol_opts = sol_opts
-        self._opts_key = tuple(sorted((k, repr(v)) for k, v in sol_opts.items()))
+        # a failure that will be retried should not spend the whole step budget first
+        self._retry_opts = dict(sol_opts, max_num_steps=min(
+            int(sol_opts.get("max_num_steps", max_steps)), self.opts.retry_steps))
         self._one: ca.Function | None = None
         hyb = dae.hybrid or HybridPart()
         nb = dae.n_base
@@ -229,7 +234,7 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
                 X, Z = self._columns(t0, x, z, offsets)
             else:        # a failure is expected now and then (retried): keep SUNDIALS quiet
                 with _quiet_stderr():
-                    X, Z = self._columns(t0, x, z, offsets)
+                    X, Z = self._columns(t0, x, z, offsets, self._retry_opts)
         except RuntimeError:
             # with dynamic state selection the current choice may fail before the next pivot
             # check, and a branch kept past a crossing not yet checked may be singular (a
@@ -277,9 +282,10 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
             return (*crossing[:3], crossing[3], passed)
         return t1, X[:, -1], Z[:, -1] if nz else z, None, passed
 
-    def _columns(self, t0: float, x, z, offsets: np.ndarray):
-        """States and algebraic variables at ``t0 + offsets`` (one integrator call, or
-        algebraic solves for a model without states)."""
+    def _columns(self, t0: float, x, z, offsets: np.ndarray, opts: dict | None = None):
+        """States and algebraic variables at ``t0 + offsets`` (one integrator call with the
+        solver options ``opts``, by default the run's, or algebraic solves for a model without
+        states)."""
         nz = self.dae.z.numel()
         n_t = len(offsets)
         if len(x) == 0:
@@ -287,23 +293,24 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
             for c, off in enumerate(offsets):
                 Z[:, c] = self._solve_z(t0 + float(off), x)
             return np.zeros((0, n_t)), Z
-        F = self._shifted(tuple(offsets))
+        F = self._shifted(tuple(offsets), opts or self._sol_opts)
         res = F(x, z, np.concatenate([self.p, [t0]]))
         self.n_segments += 1
         X = res[0].reshape(n_t, len(x)).T.copy()
         Z = res[1].reshape(n_t, nz).T.copy() if nz else np.zeros((0, n_t))
         return X, Z
 
-    def _shifted(self, offsets: tuple[float, ...]) -> Fast:
-        """An integrator from t0 (a parameter) to ``t0 + offsets`` (cached)."""
-        cache = self.dae.cache.setdefault(("shifted", self._opts_key), {})
+    def _shifted(self, offsets: tuple[float, ...], opts: dict) -> Fast:
+        """An integrator from t0 (a parameter) to ``t0 + offsets`` (cached by options)."""
+        key = ("shifted", tuple(sorted((k, repr(v)) for k, v in opts.items())))
+        cache = self.dae.cache.setdefault(key, {})
         if len(offsets) > 64:                       # long runs: not worth keeping
-            return Fast(_integrator(self.dae, self._sol_opts, list(offsets), scaled=False))
+            return Fast(_integrator(self.dae, opts, list(offsets), scaled=False))
         F = cache.get(offsets)
         if F is None:
             if len(cache) > 64:
                 cache.pop(next(iter(cache)))
-            F = Fast(_integrator(self.dae, self._sol_opts, list(offsets), scaled=False))
+            F = Fast(_integrator(self.dae, opts, list(offsets), scaled=False))
             cache[offsets] = F
         return F
 
