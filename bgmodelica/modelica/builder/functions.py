@@ -318,13 +318,18 @@ def _fn_div(node: A.Call, ctx: Ctx) -> Any:
 
 
 def _fn_size(node: A.Call, ctx: Ctx) -> Any:
+    args = None
     if ctx.numeric and node.args:
         # the size of a variable array is known when built even if its values are not
-        first = evaluate(node.args[0], Ctx(ctx.env, ctx.lex, ctx.loops, False))
-        rest = _args(A.Call(node.func, node.args[1:], node.kwargs, node.pos), ctx, (0, 1),
-                     "size")
-        args = [first, *rest]
-    else:
+        try:
+            first = evaluate(node.args[0], Ctx(ctx.env, ctx.lex, ctx.loops, False))
+        except NotConstant:     # a parameter of an instance still being built: by value
+            first = None
+        if first is not None:
+            rest = _args(A.Call(node.func, node.args[1:], node.kwargs, node.pos), ctx,
+                         (0, 1), "size")
+            args = [first, *rest]
+    if args is None:
         args = _args(node, ctx, (1, 2), "size")
     shape = _shape(args[0])
     if len(args) == 1:
