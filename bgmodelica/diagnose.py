@@ -311,11 +311,16 @@ def check_result(result: Any, dae: Any, p: Any) -> None:
            "; check the parameter and start values"), t_ok, kept)
 
 
-def singular_linear_block(residuals: list, unknowns: list, tries: int = 2) -> bool:
+def singular_linear_block(residuals: list, unknowns: list, tries: int = 2,
+                          discrete: frozenset[int] = frozenset()) -> bool:
     """Whether the block ``residuals = 0``, linear in ``unknowns``, is singular for every
     value of the other symbols (its Jacobian is rank-deficient at random points): equations
     that structural analysis matched but that are linearly dependent (ideal sources in a
-    loop or a cut, a state fixed by a constraint that index reduction could not see)."""
+    loop or a cut, a state fixed by a constraint that index reduction could not see).
+
+    Symbols whose element hash is in ``discrete`` (Booleans, modes, relation values) take
+    random 0/1 values: a block singular in some combination of modes only (one the discrete
+    equations never produce) is not singular for every value."""
     if not unknowns:
         return False
     r, v = ca.vertcat(*residuals), ca.vertcat(*unknowns)
@@ -326,10 +331,15 @@ def singular_linear_block(residuals: list, unknowns: list, tries: int = 2) -> bo
         m = np.asarray(ca.DM(ca.evalf(a)), dtype=float)
         return bool(np.all(np.isfinite(m)) and np.linalg.matrix_rank(m) < n)
     f = ca.Function("bgm_jac", [ca.vertcat(*syms)], [a])
+    is_discrete = np.array([s.element_hash() in discrete for s in syms])
+    if is_discrete.any():
+        tries = max(tries, 8)
     rng = np.random.default_rng(2024)
     for _ in range(tries):
+        x = rng.uniform(0.5, 1.5, len(syms))
+        x[is_discrete] = rng.integers(0, 2, int(is_discrete.sum()))
         with np.errstate(all="ignore"):
-            m = np.asarray(f(rng.uniform(0.5, 1.5, len(syms))), dtype=float)
+            m = np.asarray(f(x), dtype=float)
         if not np.all(np.isfinite(m)) or np.linalg.matrix_rank(m) == n:
             return False
     return True

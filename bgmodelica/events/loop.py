@@ -512,10 +512,11 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         return x, z, out
 
     def _keep_settled(self, t: float, g: np.ndarray, dgdt: np.ndarray, before) -> None:
-        """Relations on algebraic variables at rounding level change again only once their
-        indicator is past the tolerance: one left against the sign of its indicator (settled
-        within the tolerance), and one whose crossing vanished when the algebraic variables
-        were solved again at the event (the integrator's algebraic error made it)."""
+        """Relations at rounding level change again only once their indicator is past the
+        tolerance: one left against the sign of its indicator (settled within the tolerance,
+        e.g. a friction element sliding with zero relative acceleration), and one on
+        algebraic variables whose crossing vanished when they were solved again at the event
+        (the integrator's algebraic error made it)."""
         fn = self.fn
         value = self.p[fn.rel_slot]
         tol = self.opts.relation_tol
@@ -523,19 +524,35 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         if before is not None:
             g_left, frozen = before
             vanished = (self._relation_values(t, g_left, dgdt) != frozen) & (value == frozen)
-            keep |= vanished & (np.abs(g) <= tol) & (np.abs(g_left) <= tol)
-        self.hysteresis = np.where(keep & self._on_z, tol, 0.0)
+            keep |= vanished & (np.abs(g) <= tol) & (np.abs(g_left) <= tol) & self._on_z
+        self.hysteresis = np.where(keep, tol, 0.0)
 
     def _settle(self, t: float, x, cycle: _Cycle) -> np.ndarray:
         """Relation values of a mixed system whose event iteration cycles (see
-        :mod:`.mixed`); raises :class:`EventError` when no combination is consistent."""
+        :mod:`.mixed`); raises :class:`EventError` when no combination is consistent.
+
+        Under each combination the discrete variables defined by equations settle first
+        (their pre() catches up, as in the event iteration with the relations frozen). A
+        combination may be consistent only with the pre() values another one leads to (a
+        friction element that keeps sliding once it started: ``pre(startForward)``), so
+        the search is repeated from each of those."""
         fn = self.fn
         saved = self.p[fn.rel_slot].copy()
+        pre_slot, lagging = fn.pre_slot, fn.pre_discrete
+        saved_pre = self.p[pre_slot].copy()
+        reached: dict[bytes, np.ndarray] = {}
 
         def evaluate(trial: np.ndarray):
             self.p[fn.rel_slot] = trial
-            z = self._solve_z(t, x) if fn.alg_solver is not None else np.zeros(0)
-            g, dgdt, *_ = self._step(t, x, z)
+            self.p[pre_slot] = start_pre
+            for _ in range(self.opts.max_iterations):
+                z = self._solve_z(t, x) if fn.alg_solver is not None else np.zeros(0)
+                g, dgdt, *_, pre_src, _ = self._step(t, x, z)
+                moved = lagging & (pre_src != self.p[pre_slot])
+                if not moved.any():
+                    break
+                self.p[pre_slot] = np.where(lagging, pre_src, self.p[pre_slot])
+            reached.setdefault(self.p[pre_slot].tobytes(), self.p[pre_slot].copy())
             return self._relation_values(t, g, dgdt), g
 
         free = list(np.nonzero(cycle.free)[0])
@@ -543,12 +560,23 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         if len(free) > mixed.MAX_FREE:
             raise EventError(f"event iteration at t = {t:g} s cycles through {len(free)} "
                              f"relations ({names}, ...), too many to search", t)
+        start_pre = saved_pre
         found, miss = mixed.search(evaluate, cycle.first, free, self.opts.relation_tol)
+        for start_pre in list(reached.values()) if found is None else []:
+            if np.array_equal(start_pre, saved_pre):
+                continue
+            found, other = mixed.search(evaluate, cycle.first, free, self.opts.relation_tol)
+            miss = min(miss, other)
+            if found is not None:
+                break
         self.p[fn.rel_slot] = saved
         if found is None:
+            self.p[pre_slot] = saved_pre
             raise EventError(f"event iteration at t = {t:g} s: no consistent values of "
                              f"{names} (the mixed system they close has no solution; the "
                              f"closest misses by {miss:.3g})", t)
+        evaluate(found)                     # the pre() values the combination settles to
+        self.p[fn.rel_slot] = saved
         cycle.settled(found)
         return found
 

@@ -140,6 +140,7 @@ def sort_equations(reduced: ReducedModel) -> SortedDAE:
         out.n_explicit = len(scalar)
         return out
     var_hashes: set[int] = set()
+    discrete: frozenset[int] = frozenset()
     k = -1                                      # position of the block among the scalar ones
     for block in blocks:
         eqs, cols = block.eqs, block.vars
@@ -160,9 +161,10 @@ def sort_equations(reduced: ReducedModel) -> SortedDAE:
             continue
         if not var_hashes:
             var_hashes.update(v.sx.element_hash() for v in variables)
+            discrete = _discrete_hashes(model)
         names = [variables[unknowns[c]].name for c in cols]
         _loop(out, list(eqs), list(cols), eq_cols, res, sym, unknowns, names, variables,
-              var_hashes)
+              var_hashes, discrete)
     return out
 
 
@@ -206,6 +208,13 @@ def _switches_on(e: ca.SX, var: ca.SX) -> bool:
     return False
 
 
+def _discrete_hashes(model) -> frozenset[int]:
+    """Element hashes of the discrete symbols of ``model`` (discrete variables and the
+    hidden slots: pre() values, relation values, ...)."""
+    return frozenset([v.sx.element_hash() for v in model.variables if v.decl.kind == "discrete"]
+                     + [d.sx.element_hash() for d in model.discretes])
+
+
 def _dependent(model, eqs: list[int], names: list[str]) -> UnbalancedModelError:
     """A linear block whose equations are linearly dependent for every parameter value."""
     shown = "; ".join(model.describe(e) for e in eqs[:4]) + ("; ..." if len(eqs) > 4 else "")
@@ -218,7 +227,7 @@ def _dependent(model, eqs: list[int], names: list[str]) -> UnbalancedModelError:
 
 
 def _loop(out: SortedDAE, eqs, cols, eq_cols, res, sym, unknowns, names, variables,
-          var_hashes: set[int]) -> None:
+          var_hashes: set[int], discrete: frozenset[int]) -> None:
     cache: dict[tuple[int, int], ca.SX | None] = {}
 
     def solved(e: int, c: int) -> ca.SX | None:
@@ -240,7 +249,8 @@ def _loop(out: SortedDAE, eqs, cols, eq_cols, res, sym, unknowns, names, variabl
                                                 [ca.vertcat(*resid)], False)
         resid = [resid_sub[k] for k in range(resid_sub.numel())]
     solution = solve_linear_block(resid, [sym[c] for c in tear_cols]) if tear_cols else None
-    if solution is not None and singular_linear_block(resid, [sym[c] for c in tear_cols]):
+    if solution is not None and singular_linear_block(resid, [sym[c] for c in tear_cols],
+                                                      discrete=discrete):
         raise _dependent(out.reduced.model, eqs, names)
     if solution is not None or not tear_cols:
         for k, c in enumerate(tear_cols):

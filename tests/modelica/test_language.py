@@ -328,3 +328,33 @@ def test_records_and_time_tables_round_trip():
     a, b = bg.simulate(Tabled(), **kw), bg.simulate(load_modelica_text(text), **kw)
     for n in ("x", "y"):
         np.testing.assert_allclose(a[n], b[n], rtol=0, atol=1e-12)
+
+
+SIZES = """
+package Sizes
+  partial block MO
+    parameter Integer nout = 1;
+    output Real y[nout];
+  end MO;
+  block Ptp "the output size from a parameter array of the block being built"
+    parameter Real q[:] = {1};
+    extends MO(final nout = size(q, 1));
+  equation
+    y = q * time;
+  end Ptp;
+  model Top
+    Ptp p(q = {1, 2, 3});
+    Real z[2];
+    Real w[2];
+  equation
+    der(z) = {1, -1};
+    w = {size(z, 1), size(p.y, 1)} "sizes of variable arrays";
+  end Top;
+end Sizes;
+"""
+
+
+def test_size_of_parameter_and_variable_arrays():
+    r = _sim(load_modelica_text(SIZES, "Sizes.Top"), stop_time=1.0)
+    np.testing.assert_allclose(r["p.y[3]"][-1], 3.0)
+    np.testing.assert_allclose([r["w[1]"][-1], r["w[2]"][-1]], [2.0, 3.0])
