@@ -64,7 +64,7 @@ def _rows_before(result: Any, k: int) -> Any:
 
 def model_asserts(compiled: Any) -> list:
     """The assertions of a compiled model (none for models without)."""
-    flat = getattr(compiled, "flat", None)
+    flat = vars(compiled).get("flat")       # not made on demand: array-path models have none
     return list(getattr(flat, "asserts", None) or [])
 
 

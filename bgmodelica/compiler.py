@@ -257,7 +257,7 @@ def _compile_cached(model: Component, units: str, cache: bool | str | Path) -> C
 
 
 def _compile(model: Component, select: Selector | None, units: str = "error",
-             zero_terms: bool = True) -> CompiledModel:
+             zero_terms: bool | None = None) -> CompiledModel:
     if not isinstance(model, Component):
         raise DeclarationError(
             f"compile() expects a Component instance, got {type(model).__name__}")
@@ -273,9 +273,11 @@ def _compile(model: Component, select: Selector | None, units: str = "error",
     check_alias_state_select(flat)
     raw = flat
     flat = eliminate_aliases(flat)
-    flat.asserts = raw.asserts
     lap("alias")
+    if zero_terms is None:   # Modelica models: zero parameters are evaluated, as tools do
+        zero_terms = model.__dict__.get("_mo_source") is not None
     flat, evaluated = evaluate_zero_terms(flat) if zero_terms else (flat, {})
+    flat.asserts = raw.asserts
     lap("zero_terms")
     try:
         balance = check_balance(flat)
