@@ -63,7 +63,7 @@ def equations_of(env: Env, eqs: list, initial: bool = False) -> list:
 def _eval_equation(eq: Any, ctx: Ctx, out: list, initial: bool) -> None:
     try:
         if isinstance(eq, A.Statements):
-            from .algorithms import section_equations
+            from .sections import section_equations
 
             section_equations(eq, ctx, out, initial)
         elif isinstance(eq, A.EqSimple) and isinstance(eq.lhs, A.TupleExpr):
@@ -232,7 +232,7 @@ def _deep_copy(v: Any) -> Any:
 
 def _tuple_equation(eq: A.EqSimple, ctx: Ctx, out: list, initial: bool) -> None:
     """``(a, , b) = f(x)``: one equation per named output."""
-    from .algorithms import call_outputs
+    from .calls import call_outputs
 
     if not isinstance(eq.rhs, A.Call):
         raise fail(ctx.lex, eq, "a tuple equation needs a function call on the right")

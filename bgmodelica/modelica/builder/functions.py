@@ -22,7 +22,7 @@ from .types import check_der_argument
 def _ev_call(node: A.Call, ctx: Ctx) -> Any:
     target = _function_target(node, ctx)
     if isinstance(target, S.ClassScope):
-        from .algorithms import call_function
+        from .calls import call_function
 
         return call_function(target, node, ctx)
     handler = _FUNCTIONS.get(target)
