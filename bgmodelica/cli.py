@@ -424,39 +424,9 @@ def _error_line(err: BaseException) -> str:
     return f"error: {type(err).__name__}: {one_line(str(err))}"
 
 
-def _modelica_path_options(argv: list[str]) -> list[str]:
-    """Take ``--modelica-path DIR`` (any number, anywhere on the line) out of ``argv`` and
-    put the folders on the Modelica library path."""
-    from .modelica.library_path import add_modelica_path
-
-    rest: list[str] = []
-    folders: list[str] = []
-    k = 0
-    while k < len(argv):
-        a = argv[k]
-        if a == "--modelica-path":
-            if k + 1 >= len(argv):
-                raise ModelError("--modelica-path needs a folder")
-            folders.append(argv[k + 1])
-            k += 2
-            continue
-        if a.startswith("--modelica-path="):
-            folders.append(a.partition("=")[2])
-        else:
-            rest.append(a)
-        k += 1
-    if folders:
-        add_modelica_path(*folders)
-        # worker processes (sweeps on Dask, cosim) read the same libraries
-        import os
-
-        os.environ["MODELICAPATH"] = os.pathsep.join(
-            [str(Path(f).resolve()) for f in folders]
-            + [e for e in os.environ.get("MODELICAPATH", "").split(os.pathsep) if e])
-    return rest
-
-
 def main(argv: Sequence[str] | None = None) -> int:
+    from .modelica.cli import modelica_path_options
+
     global _TERMINAL
     import contextlib
     import io
@@ -467,7 +437,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         return 0
     try:
-        argv = _modelica_path_options(list(sys.argv[1:] if argv is None else argv))
+        argv = modelica_path_options(list(sys.argv[1:] if argv is None else argv))
     except ModelError as err:
         print(_error_line(err), file=sys.stderr)
         return 2

@@ -137,3 +137,36 @@ def register(sub: Any, model_args: Any) -> None:
                    help="load the file back and check it compiles to the same variables and "
                         "equations")
     p.set_defaults(func=cmd_export_mo)
+
+
+def modelica_path_options(argv: list[str]) -> list[str]:
+    """Take ``--modelica-path DIR`` (any number, anywhere on the line) out of ``argv`` and
+    put the folders on the Modelica library path."""
+    from .errors import ModelicaError
+    from .library_path import add_modelica_path
+
+    rest: list[str] = []
+    folders: list[str] = []
+    k = 0
+    while k < len(argv):
+        a = argv[k]
+        if a == "--modelica-path":
+            if k + 1 >= len(argv):
+                raise ModelicaError("--modelica-path needs a folder")
+            folders.append(argv[k + 1])
+            k += 2
+            continue
+        if a.startswith("--modelica-path="):
+            folders.append(a.partition("=")[2])
+        else:
+            rest.append(a)
+        k += 1
+    if folders:
+        add_modelica_path(*folders)
+        # worker processes (sweeps on Dask, cosim) read the same libraries
+        import os
+
+        os.environ["MODELICAPATH"] = os.pathsep.join(
+            [str(Path(f).resolve()) for f in folders]
+            + [e for e in os.environ.get("MODELICAPATH", "").split(os.pathsep) if e])
+    return rest

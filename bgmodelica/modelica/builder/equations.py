@@ -262,7 +262,9 @@ def _eval_call_equation(eq: A.EqCall, ctx: Ctx, out: list, initial: bool) -> Non
         _connect(a, b, ctx, eq, out)
         return
     if name == "assert":
-        _assert(call, ctx, out, initial)
+        from .asserts import assert_equation
+
+        assert_equation(call, ctx, out, initial)
         return
     if name == "reinit":
         raise fail(ctx.lex, eq, "reinit() is allowed only inside a when-equation")
@@ -270,58 +272,6 @@ def _eval_call_equation(eq: A.EqCall, ctx: Ctx, out: list, initial: bool) -> Non
         raise fail(ctx.lex, eq, "unsupported Modelica construct: terminate()")
     raise fail(ctx.lex, eq, f"{name}(...) is not an equation (write 'expression = "
                "expression')")
-
-
-def _assert(call: A.Call, ctx: Ctx, out: list, initial: bool) -> None:
-    """``assert(condition, message, level)``: false when built: an error now; time-varying:
-    checked while simulating (:mod:`bgmodelica.asserts`)."""
-    if not call.args:
-        raise fail(ctx.lex, call, "assert(condition, message) needs a condition")
-    level_node = call.kwargs.get("level") or (call.args[2] if len(call.args) > 2 else None)
-    level = "warning" if level_node is not None and "warning" in getattr(
-        level_node, "dotted", "") else "error"
-    cond = evaluate(call.args[0], ctx)
-    message = _assert_message(call, ctx)
-    if isinstance(cond, Expr):
-        try:
-            cond = numeric_value(cond, ctx.lex, call)      # parameters only: known now
-        except NotConstant:
-            pass
-    if not isinstance(cond, Expr):
-        if not cond and level == "error":
-            raise fail(ctx.lex, call, f"assert failed: {message}")
-        return
-    if not initial:
-        out.append(H.assert_(cond, f"{message} ({_where_text(ctx, call)})", level))
-
-
-def _assert_message(call: A.Call, ctx: Ctx) -> str:
-    if len(call.args) < 2 and "message" not in call.kwargs:
-        return "assertion"
-    node = call.args[1] if len(call.args) > 1 else call.kwargs["message"]
-    try:
-        msg = evaluate(node, ctx)
-    except Exception:  # noqa: BLE001 -- a message built from time-varying values: its text
-        msg = None
-    if isinstance(msg, str):
-        return " ".join(msg.split())
-    parts = []
-
-    def strings(n: Any) -> None:
-        if isinstance(n, A.Str):
-            parts.append(n.value)
-        elif isinstance(n, A.BinOp):
-            strings(n.a)
-            strings(n.b)
-
-    strings(node)
-    return " ".join(" ".join(parts).split()) or "assertion"
-
-
-def _where_text(ctx: Ctx, node: Any) -> str:
-    from .base import _where
-
-    return _where(ctx.lex, node.pos)
 
 
 def _connect(a: Any, b: Any, ctx: Ctx, node: Any, out: list) -> None:
