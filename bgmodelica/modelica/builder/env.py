@@ -180,3 +180,38 @@ def static_env(scope: S.ClassScope) -> Env:
         env = Env(class_view(scope), {}, None, scope.full_name)
         scope._static = env
     return env
+
+
+def _unbuilt_child(env: Env, name: str) -> bool:
+    """Whether ``name`` is a subcomponent of ``env`` not built yet (a sibling's modifier
+    reads its parameters: ``startTime = -vIn.rising``)."""
+    if name in env.disabled:
+        return False
+    info = env.view.elements[name]
+    if _category(info, type_ref(info)) != "child" or info.comp.dims:
+        return False
+    inst = env.inst
+    return inst is None or name not in inst._children
+
+
+def sibling_parameter(env: Env, name: str, rest: tuple) -> tuple | None:
+    """``(value,)`` of a parameter of subcomponent ``name`` of ``env`` not built yet (a
+    sibling's modifier reads it: ``startTime = -vIn.rising``): its modifier here, else its
+    class's value; None when ``name`` is built (or switched off) or ``rest`` names no
+    parameter."""
+    if not _unbuilt_child(env, name):
+        return None
+    (pname, subs), more = rest[0], rest[1:]
+    if more or subs:
+        return None
+    try:
+        m = env.emod(name)
+        sub = m.sub.get(pname) if m is not None else None
+        if sub is not None and sub.has_binding:
+            return (sub.value(True),)
+        tref = type_ref(env.view.elements[name])
+        if tref.kind != "class" or tref.scope is None:
+            return None
+        return (static_env(tref.scope).numeric(pname),)
+    except (NotConstant, KeyError):
+        return None

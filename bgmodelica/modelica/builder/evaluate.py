@@ -21,7 +21,7 @@ from .arith import (
 )
 from .base import Ctx, NotConstant, _Disabled, check_array_size, fail, numeric_value
 from .classes import class_view, type_ref
-from .env import Env, _category, static_env
+from .env import Env, _category, sibling_parameter, static_env
 from .expandable import Bus, declared_member
 from .types import check_condition, check_number_operands
 
@@ -81,11 +81,11 @@ def _ev_ref(node: A.Ref, ctx: Ctx) -> Any:
             raise NotConstant(name)
         val = _lexical_value(found, ctx, node)
     elif env is not None and name in env.view.elements and len(parts) > 1 \
-            and _unbuilt_child(env, name) and _child_parameter(env, name, parts[1:]):
+            and (got := sibling_parameter(env, name, parts[1:])) is not None:
         tref = type_ref(env.view.elements[name])
         if tref.kind == "class" and tref.scope is not None:
             _check_public_in(class_view(tref.scope), parts[1][0], name, ctx.lex, node)
-        return _child_parameter(env, name, parts[1:])[0]
+        return got[0]
     elif env is not None and name in env.view.elements:
         val = _env_member(env, name, ctx, node)
     elif env is not None and env.inst is not None and (
@@ -125,37 +125,6 @@ def _ev_ref(node: A.Ref, ctx: Ctx) -> Any:
         if subs:
             val = _subscript(val, subs, ctx, node)
     return val
-
-
-def _unbuilt_child(env: Env, name: str) -> bool:
-    """Whether ``name`` is a subcomponent of ``env`` not built yet (a sibling's modifier
-    reads its parameters: ``startTime = -vIn.rising``)."""
-    if name in env.disabled:
-        return False
-    info = env.view.elements[name]
-    if _category(info, type_ref(info)) != "child" or info.comp.dims:
-        return False
-    inst = env.inst
-    return inst is None or name not in inst._children
-
-
-def _child_parameter(env: Env, name: str, rest: tuple) -> tuple | None:
-    """``(value,)`` of a parameter of a subcomponent not built yet (its modifier here, else
-    its class's value), or None when ``rest`` does not name one."""
-    (pname, subs), more = rest[0], rest[1:]
-    if more or subs:
-        return None
-    try:
-        m = env.emod(name)
-        sub = m.sub.get(pname) if m is not None else None
-        if sub is not None and sub.has_binding:
-            return (sub.value(True),)
-        tref = type_ref(env.view.elements[name])
-        if tref.kind != "class" or tref.scope is None:
-            return None
-        return (static_env(tref.scope).numeric(pname),)
-    except (NotConstant, KeyError):
-        return None
 
 
 def _map_member(val: list, name: str, ctx: Ctx, node: Any) -> list:
