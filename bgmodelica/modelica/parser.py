@@ -397,7 +397,7 @@ _LOCK = threading.Lock()
 def _parse(text: str, file: str) -> tuple[A.StoredDefinition, list[A.ClassDef]]:
     """The syntax tree of ``text`` and every class definition in it."""
     lark, rules = _lark()
-    with _LOCK:                           # the rules hold the file being parsed
+    with _LOCK, ast_cache.paused_gc():    # the rules hold the file being parsed
         rules.file, rules.classes = file, []
         try:
             return lark.parse(text), rules.classes
