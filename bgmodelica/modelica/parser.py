@@ -430,6 +430,8 @@ def _syntax_error(err: UnexpectedInput, text: str, file: str) -> ModelicaSyntaxE
     expected = sorted(getattr(err, "expected", None) or getattr(err, "accepts", None) or [])
     shown = ", ".join(_terminal_text(t) for t in expected[:8])
     more = ", ..." if len(expected) > 8 else ""
+    if len(value) > 40:                   # a long string: its start is enough
+        value = value[:36] + " ..." + value[0]
     return ModelicaSyntaxError(file, line, col, f"unexpected {value!r}"
                                + (f"; expected {shown}{more}" if shown else ""))
 
@@ -438,7 +440,10 @@ _TERMINAL_TEXT = {"SEMICOLON": "';'", "LPAR": "'('", "RPAR": "')'", "COMMA": "',
                   "EQUAL": "'='", "IDENT": "a name", "NUMBER": "a number", "STRING": "a string",
                   "LSQB": "'['", "RSQB": "']'", "LBRACE": "'{'", "RBRACE": "'}'",
                   "REL_OP": "a relation", "ADD_OP": "'+'/'-'", "MUL_OP": "'*'/'/'",
-                  "POW_OP": "'^'", "COLON": "':'", "DOT": "'.'", "$END": "end of file"}
+                  "POW_OP": "'^'", "COLON": "':'", "DOT": "'.'", "$END": "end of file",
+                  "ASSIGN": "':='", "DOTSTAR": "'.*'", "DOTBRACE": "'.{'",
+                  "INITIAL_EQUATION": "'initial equation'",
+                  "INITIAL_ALGORITHM": "'initial algorithm'"}
 
 
 def _terminal_text(name: str) -> str:
