@@ -1,9 +1,12 @@
-"""Parse Modelica text (the subset in ``grammar.lark``) into the syntax tree of :mod:`.ast`.
+"""Parse Modelica text (``grammar.lark``: the specification's concrete syntax) into the
+syntax tree of :mod:`.ast`.
 
-The grammar is compiled once per process by lark's LALR(1) parser generator. Syntax errors
-become :class:`ModelicaSyntaxError` with ``file:line:column`` and what was expected. The rules
-for classes and elements are here, those for equations and expressions in
-:mod:`.expression_rules`.
+The grammar is compiled once per process by lark's LALR(1) parser generator, with the rules
+applied while parsing (no intermediate parse tree). Syntax errors become
+:class:`ModelicaSyntaxError` with ``file:line:column`` and what was expected. The rules for
+classes and elements are here, those for statements in :mod:`.statement_rules`, for equations
+and expressions in :mod:`.expression_rules`. :func:`parse_file` caches parsed files in the
+process and on disk (:mod:`.ast_cache`).
 """
 
 from __future__ import annotations
@@ -25,7 +28,7 @@ from .statement_rules import StatementRules
 
 _GRAMMAR = Path(__file__).with_name("grammar.lark")
 
-#: keywords and words of full Modelica that the subset does not read, with what they start
+#: words that start a construct the grammar does not read, with what they start
 UNSUPPORTED_WORDS = {
     "Clock": "synchronous (clocked) language elements",
     "subSample": "synchronous (clocked) language elements",
