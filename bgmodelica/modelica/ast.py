@@ -319,7 +319,7 @@ class Import:
 
 @dataclass(slots=True)
 class Unsupported:
-    """A construct parsed only to be refused with its position (algorithm sections...)."""
+    """A construct the builder refuses, with its position (see ``builder.classes.refused``)."""
 
     what: str
     pos: Pos = (0, 0)
@@ -336,7 +336,7 @@ class ClassDef:
     equations: list = field(default_factory=list)
     initial_equations: list = field(default_factory=list)
     annotation: Modification | None = None
-    unsupported: list = field(default_factory=list)    # Unsupported sections
+    unsupported: list = field(default_factory=list)    # Unsupported entries
     # short class  ``type T = prefix Base[dims](mod)``
     short: tuple | None = None    # (base_prefix, type_name, dims, Modification|None)
     enum: tuple | None = None     # enumeration literals

@@ -12,10 +12,12 @@ be written simply leaves the cache unused.
 
 from __future__ import annotations
 
+import gc
 import hashlib
 import os
 import pickle
 import tempfile
+from contextlib import contextmanager
 from functools import lru_cache
 from pathlib import Path
 
@@ -36,6 +38,20 @@ def parser_version() -> str:
     return h.hexdigest()
 
 
+@contextmanager
+def paused_gc():
+    """Pause the cyclic garbage collector while a syntax tree is built or loaded: its millions
+    of small objects would otherwise trigger full collections again and again (loading the
+    whole MSL took 5x longer)."""
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was:
+            gc.enable()
+
+
 def folder() -> Path:
     """``$BGMODELICA_CACHE/modelica-ast`` (default ``~/.cache/bgmodelica/modelica-ast``)."""
     from ..cache import default_dir
@@ -51,7 +67,7 @@ def entry_path(data: bytes) -> Path:
 def load(data: bytes, file: str) -> A.StoredDefinition | None:
     """The cached parse of ``data`` with its file names set to ``file``, or None."""
     try:
-        with open(entry_path(data), "rb") as fh:
+        with open(entry_path(data), "rb") as fh, paused_gc():
             tree, classes = pickle.load(fh)
     except Exception:                     # missing, truncated, corrupt or from elsewhere
         return None

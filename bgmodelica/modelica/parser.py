@@ -1,9 +1,12 @@
-"""Parse Modelica text (the subset in ``grammar.lark``) into the syntax tree of :mod:`.ast`.
+"""Parse Modelica text (``grammar.lark``: the specification's concrete syntax) into the
+syntax tree of :mod:`.ast`.
 
-The grammar is compiled once per process by lark's LALR(1) parser generator. Syntax errors
-become :class:`ModelicaSyntaxError` with ``file:line:column`` and what was expected. The rules
-for classes and elements are here, those for equations and expressions in
-:mod:`.expression_rules`.
+The grammar is compiled once per process by lark's LALR(1) parser generator, with the rules
+applied while parsing (no intermediate parse tree). Syntax errors become
+:class:`ModelicaSyntaxError` with ``file:line:column`` and what was expected. The rules for
+classes and elements are here, those for statements in :mod:`.statement_rules`, for equations
+and expressions in :mod:`.expression_rules`. :func:`parse_file` caches parsed files in the
+process and on disk (:mod:`.ast_cache`).
 """
 
 from __future__ import annotations
@@ -26,7 +29,7 @@ from .statement_rules import StatementRules
 
 _GRAMMAR = Path(__file__).with_name("grammar.lark")
 
-#: keywords and words of full Modelica that the subset does not read, with what they start
+#: words that start a construct the grammar does not read, with what they start
 UNSUPPORTED_WORDS = {
     "Clock": "synchronous (clocked) language elements",
     "subSample": "synchronous (clocked) language elements",
@@ -411,7 +414,7 @@ _LOCK = threading.Lock()
 def _parse(text: str, file: str) -> tuple[A.StoredDefinition, list[A.ClassDef]]:
     """The syntax tree of ``text`` and every class definition in it."""
     lark, rules = _lark()
-    with _LOCK:                           # the rules hold the file being parsed
+    with _LOCK, ast_cache.paused_gc():    # the rules hold the file being parsed
         rules.file, rules.classes = file, []
         try:
             return lark.parse(text), rules.classes
@@ -444,6 +447,8 @@ def _syntax_error(err: UnexpectedInput, text: str, file: str) -> ModelicaSyntaxE
     expected = sorted(getattr(err, "expected", None) or getattr(err, "accepts", None) or [])
     shown = ", ".join(_terminal_text(t) for t in expected[:8])
     more = ", ..." if len(expected) > 8 else ""
+    if len(value) > 40:                   # a long string: its start is enough
+        value = value[:36] + " ..." + value[0]
     return ModelicaSyntaxError(file, line, col, f"unexpected {value!r}"
                                + (f"; expected {shown}{more}" if shown else ""))
 
@@ -452,7 +457,10 @@ _TERMINAL_TEXT = {"SEMICOLON": "';'", "LPAR": "'('", "RPAR": "')'", "COMMA": "',
                   "EQUAL": "'='", "IDENT": "a name", "NUMBER": "a number", "STRING": "a string",
                   "LSQB": "'['", "RSQB": "']'", "LBRACE": "'{'", "RBRACE": "'}'",
                   "REL_OP": "a relation", "ADD_OP": "'+'/'-'", "MUL_OP": "'*'/'/'",
-                  "POW_OP": "'^'", "COLON": "':'", "DOT": "'.'", "$END": "end of file"}
+                  "POW_OP": "'^'", "COLON": "':'", "DOT": "'.'", "$END": "end of file",
+                  "ASSIGN": "':='", "DOTSTAR": "'.*'", "DOTBRACE": "'.{'",
+                  "INITIAL_EQUATION": "'initial equation'",
+                  "INITIAL_ALGORITHM": "'initial algorithm'"}
 
 
 def _terminal_text(name: str) -> str:

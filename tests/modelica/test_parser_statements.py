@@ -149,3 +149,18 @@ def test_malformed_statements_positioned(text):
     with pytest.raises(ModelicaSyntaxError) as info:
         parse_text(text, "bad.mo")
     assert str(info.value).startswith("bad.mo:") and "\n" not in str(info.value)
+
+
+def test_class_extends_end_name_mismatch():
+    with pytest.raises(ModelicaSyntaxError) as info:
+        parse_text("package P\n  redeclare model extends A\n  end B;\nend P;\n", "bad.mo")
+    assert str(info.value).startswith("bad.mo:3:7: class A is closed by 'end B'")
+
+
+def test_builder_refuses_class_extends():
+    from bgmodelica.modelica import ModelicaError, load_modelica_text
+    text = ("package P\n  model A\n    Real x;\n  equation\n    x = 1;\n  end A;\n"
+            "  model extends A\n  end A;\nend P;\n")
+    with pytest.raises(ModelicaError) as info:
+        load_modelica_text(text, "P.A", file="e.mo")
+    assert "unsupported Modelica construct: class extends" in str(info.value)
