@@ -101,14 +101,12 @@ def test_long_token_shortened_in_message():
 
 
 @pytest.mark.parametrize("text, line, col, what", [
-    ("model M\n  Real x;\ninitial algorithm\n  x := 1;\nend M;\n", 3, 1,
-     "initial algorithm section"),
     ("model M\n  Real x;\n  function f\n    input Real u;\n    output Real y;\n"
      "  external \"C\";\n  end f;\nequation\n  x = 1;\nend M;\n", None, None, None),
     ("model B\n  Real x;\nexternal \"C\";\nend B;\nmodel M\n  extends B;\nend M;\n", 3, 1,
      "external function"),
 ])
-def test_builder_refuses_algorithms_and_external(text, line, col, what):
+def test_builder_refuses_an_external_clause_in_a_model(text, line, col, what):
     if what is None:                  # a function declared, never called: not refused
         load_modelica_text(text, "M", file="r.mo")
         return
