@@ -22,7 +22,7 @@ from typing import Any
 def experiment_of_reference(ref: str) -> dict[str, float]:
     """The experiment annotation of ``file.mo:Package.Model`` without building the model
     ({} when the reference is not Modelica or cannot be read: loading reports that)."""
-    from . import is_library_class, is_reference
+    from . import _file_in_library, is_library_class, is_reference
 
     if not is_reference(ref):
         return {}
@@ -40,7 +40,18 @@ def experiment_of_reference(ref: str) -> dict[str, float]:
             path, name = ref, None
         else:
             path, _, name = ref.rpartition(":")
-        file = FileScope(parse_file(path))
+        stored = parse_file(path)
+        root = _file_in_library(stored, Path(path))
+        if root is not None and name:           # a file of a package folder
+            from .library_path import add_modelica_path, resolve
+
+            add_modelica_path(root)
+            within = stored.within or ""
+            full = name if not within or name.startswith(within.split(".")[0] + ".") \
+                else f"{within}.{name}"
+            scope = resolve(full)
+            return experiment(scope) if scope is not None else {}
+        file = FileScope(stored)
         if not name:
             models = list_models(file)
             if len(models) != 1:

@@ -120,3 +120,14 @@ def test_a_misspelt_class_is_named_with_suggestions(msl):
     with pytest.raises(ModelicaError, match="did you mean Modelica.Mechanics.Rotational."
                                             "Examples.First"):
         load_class("Modelica.Mechanics.Rotational.Examples.Frist")
+
+
+def test_a_file_of_the_package_folder_with_its_experiment(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("MODELICAPATH", "")
+    monkeypatch.setattr(LP, "_extra", [])
+    LP.clear()
+    out = tmp_path / "first.csv"
+    ref = f"{MSL / 'Modelica' / 'package.mo'}:Modelica.Mechanics.Rotational.Examples.First"
+    assert main(["simulate", ref, "-o", str(out)]) == 0, capsys.readouterr().err
+    last = out.read_text().splitlines()[-1].split(",")
+    assert float(last[0]) == pytest.approx(1.0)      # the experiment annotation's StopTime
