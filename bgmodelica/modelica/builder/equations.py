@@ -131,17 +131,25 @@ def _discrete_start(a: Any, b: Any, ctx: Ctx, node: Any) -> bool:
     if decl is None or not (decl.kind == KIND_DISCRETE or decl.kind == KIND_OUTPUT
                             and getattr(decl, "type_name", "Real") != "Real"):
         return False
-    try:
-        # at initialization time is the start time, 0 in the examples of the libraries
-        value = numeric_value(b, ctx.lex, node, {"time": INITIAL_TIME})
-    except NotConstant:
-        return False
-    if isinstance(value, S.EnumValue):
-        value = value.index
-    if not isinstance(value, (bool, int, float)):
+    value = _initial_value(b, ctx, node, fixed_starts=False)
+    if value is None:
         return False
     sym.decl = decl.evolve(start=value, fixed=True)
     return True
+
+
+def _initial_value(b: Any, ctx: Ctx, node: Any, fixed_starts: bool) -> Any:
+    """The number ``b`` is at initialization when that is known when the model is built
+    (parameters; ``time`` the start time, 0 in the libraries' examples; with
+    ``fixed_starts`` the start values of fixed variables), else None."""
+    memo: dict = {"time": INITIAL_TIME, "fixed starts": fixed_starts}
+    try:
+        value = numeric_value(b, ctx.lex, node, memo)
+    except NotConstant:
+        return None
+    if isinstance(value, S.EnumValue):
+        value = value.index
+    return value if isinstance(value, (bool, int, float)) else None
 
 
 def _parameter_value(a: Any, b: Any, ctx: Ctx, node: Any) -> bool:
@@ -165,14 +173,8 @@ def _parameter_value(a: Any, b: Any, ctx: Ctx, node: Any) -> bool:
         decl = getattr(sym, "decl", None)
         if decl is None or decl.kind != KIND_PARAMETER or _unsolved(y):
             return False
-        try:
-            value = numeric_value(y, ctx.lex, node,
-                                  {"time": INITIAL_TIME, "fixed starts": True})
-        except NotConstant:
-            return False
-        if isinstance(value, S.EnumValue):
-            value = value.index
-        if not isinstance(value, (bool, int, float)):
+        value = _initial_value(y, ctx, node, fixed_starts=True)
+        if value is None:
             return False
         solved.append((sym, decl, value))
     for sym, decl, value in solved:
