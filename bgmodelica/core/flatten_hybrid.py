@@ -149,7 +149,9 @@ def _residual(e: Any, here: str) -> Any:
 class _Rewriter:
     def __init__(self, draft: HybridDraft) -> None:
         self.draft = draft
-        self.memo: dict[tuple[int, bool], Any] = {}
+        # (id(node), rewritten) -> (node, result): holding the node keeps its id unique (a
+        # branch residual is a temporary; a later one at the same address must not hit)
+        self.memo: dict[tuple[int, bool], tuple[Any, Any]] = {}
         self.rel_memo: dict[tuple, RelationSlot] = {}
 
     def scan(self, e: Any, here: str, live: bool) -> None:
@@ -174,7 +176,7 @@ class _Rewriter:
                 continue
             if isinstance(node, Leaf):
                 self._note(node.sym)
-                memo[key] = node
+                memo[key] = (node, node)
                 continue
             inner = False if node.op == "noEvent" else lv
             if not ready:
@@ -182,10 +184,10 @@ class _Rewriter:
                 stack.extend((a, inner, False) for a in reversed(node.args)
                              if isinstance(a, Expr) and (id(a), inner and rewrite) not in memo)
                 continue
-            args = tuple(memo[(id(a), inner and rewrite)] if isinstance(a, Expr) else a
+            args = tuple(memo[(id(a), inner and rewrite)][1] if isinstance(a, Expr) else a
                          for a in node.args)
-            memo[key] = self._rebuilt(node, args, here, lv and rewrite)
-        return memo[(id(e), live and rewrite)]
+            memo[key] = (node, self._rebuilt(node, args, here, lv and rewrite))
+        return memo[(id(e), live and rewrite)][1]
 
     def _rebuilt(self, e: Op, args: tuple, here: str, live: bool) -> Any:
         """``e`` over its walked ``args``: a relation slot for a live relation."""
