@@ -126,6 +126,12 @@ class EquationSources:
     arrays: list[tuple[Any, ...]] = field(default_factory=list)
 
 
+def _same_list(memo: tuple | None, items: list) -> bool:
+    """Whether a stacked-column memo ``(list, length, column)`` was built from ``items`` as
+    it is now (the memo holds the list, so a new list never passes for a freed one)."""
+    return memo is not None and memo[0] is items and memo[1] == len(items)
+
+
 #: per-model memos kept in ``FlatModel.__dict__`` (not pickled)
 _MEMOS = frozenset({"_residual_column", "_variable_column", "_parameter_column",
                     "_incidence_memo"})
@@ -191,9 +197,8 @@ class FlatModel:
                                 ("_variable_column", self.variables, variables),
                                 ("_parameter_column", self.parameters, parameters)):
             if col is not None and col.numel() == len(items):
-                self.__dict__[key] = ((id(items), len(items)), col)
-            elif like is not None and key in like.__dict__ \
-                    and like.__dict__[key][0] == (id(items), len(items)):
+                self.__dict__[key] = (items, len(items), col)
+            elif like is not None and _same_list(like.__dict__.get(key), items):
                 self.__dict__[key] = like.__dict__[key]
 
     def __getstate__(self) -> dict[str, Any]:
@@ -201,12 +206,11 @@ class FlatModel:
         return {k: v for k, v in self.__dict__.items() if k not in _MEMOS}
 
     def _stacked(self, key: str, items: list, scalars) -> ca.SX:
-        tag = (id(items), len(items))
         memo = self.__dict__.get(key)
-        if memo is None or memo[0] != tag:
-            memo = (tag, ca.vertcat(*scalars()) if items else ca.SX(0, 1))
+        if not _same_list(memo, items):
+            memo = (items, len(items), ca.vertcat(*scalars()) if items else ca.SX(0, 1))
             self.__dict__[key] = memo
-        return memo[1]
+        return memo[2]
 
     def index(self) -> dict[str, int]:
         """Name -> index in :attr:`variables`."""

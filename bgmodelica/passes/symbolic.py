@@ -110,10 +110,12 @@ def _dense_columns(expr: ca.SX, sym_vec: ca.SX) -> np.ndarray:
 def model_incidence(model) -> list[list[int]]:
     """:func:`incidence` of a flat model's equations in its variables, computed once per
     model (the balance check and index reduction both need it; on large models it costs a
-    Jacobian sparsity pass over every equation). Recomputed if either list changed size."""
-    key = (len(model.equations), len(model.variables))
+    Jacobian sparsity pass over every equation). Recomputed if either list was replaced or
+    changed size."""
+    key = (model.equations, len(model.equations), model.variables, len(model.variables))
     memo = model.__dict__.get("_incidence_memo")
-    if memo is not None and memo[0] == key:
+    if memo is not None and all(a is b if isinstance(a, list) else a == b
+                                for a, b in zip(memo[0], key, strict=True)):
         return memo[1]
     if not model.equations:
         rows: list[list[int]] = []
