@@ -6,7 +6,10 @@ connected blocks (Tarjan), and each block is made explicit where possible:
 
 - a scalar equation linear in its unknown becomes an assignment;
 - a loop is torn; if the torn residuals are linear in the tearing variables they are solved
-  symbolically, so the loop disappears from the simulated system;
+  symbolically, so the loop disappears from the simulated system. Inside a loop, no equation
+  is solved for a variable whose coefficient vanishes in some branch of a piecewise
+  expression (``x = if s > 1 then s - 1 else 0`` does not determine ``s`` in its second
+  branch); such a variable is torn instead;
 - otherwise the tearing variables stay algebraic unknowns (IDAS ``z``) with their residuals.
 """
 
@@ -23,7 +26,13 @@ from ..errors import EquationError, UnbalancedModelError
 from ..structure import block_lower_triangular, compiled, maximum_matching, tear
 from ..structure.compiled import remap_rows
 from .index_reduction import ReducedModel
-from .symbolic import LONG_ROW, solve_linear_block, solve_linear_scalar, solve_scalar_blocks
+from .symbolic import (
+    LONG_ROW,
+    fails_in_branch,
+    solve_linear_block,
+    solve_linear_scalar,
+    solve_scalar_blocks,
+)
 
 
 @dataclass
@@ -232,7 +241,7 @@ def _loop(out: SortedDAE, eqs, cols, eq_cols, res, sym, unknowns, names, variabl
 
     def solved(e: int, c: int) -> ca.SX | None:
         if (e, c) not in cache:
-            cache[(e, c)] = solve_linear_scalar(res[e], sym[c], var_hashes)
+            cache[(e, c)] = solve_linear_scalar(res[e], sym[c], var_hashes, discrete)
         return cache[(e, c)]
 
     torn = tear(eqs, cols, eq_cols, lambda e, c: solved(e, c) is not None)
@@ -249,6 +258,9 @@ def _loop(out: SortedDAE, eqs, cols, eq_cols, res, sym, unknowns, names, variabl
                                                 [ca.vertcat(*resid)], False)
         resid = [resid_sub[k] for k in range(resid_sub.numel())]
     solution = solve_linear_block(resid, [sym[c] for c in tear_cols]) if tear_cols else None
+    if solution is not None and discrete and fails_in_branch(
+            resid, [sym[c] for c in tear_cols], solution, discrete):
+        solution = None                     # solved numerically instead
     if solution is not None and singular_linear_block(resid, [sym[c] for c in tear_cols],
                                                       discrete=discrete):
         raise _dependent(out.reduced.model, eqs, names)

@@ -138,13 +138,15 @@ def time_derivative(residual: ca.SX, syms: Sequence[ca.SX], rates: Sequence[ca.S
     return ca.simplify(out) if out.numel() == 1 else out
 
 
-def solve_linear_scalar(residual: ca.SX, var: ca.SX,
-                        variables: set[int] | None = None) -> ca.SX | None:
+def solve_linear_scalar(residual: ca.SX, var: ca.SX, variables: set[int] | None = None,
+                        discrete: frozenset[int] = frozenset()) -> ca.SX | None:
     """``var`` from ``residual(var) = 0`` when the residual is linear in ``var``, else None.
 
     With ``variables`` (SX hashes of the model's variables), only solve when the coefficient
     of ``var`` is free of variables, so the division can never be by a vanishing quantity
-    (the safe choice for tearing).
+    (the safe choice for tearing). Likewise not when the coefficient vanishes for some
+    value of the ``discrete`` symbols it reads (see :func:`may_vanish`): ``x = if s > 1
+    then s - 1 else 0`` does not determine ``s`` while the second branch is active.
     """
     if residual.is_op(ca.OP_SUB):
         lhs, rhs = residual.dep(0), residual.dep(1)
@@ -159,8 +161,34 @@ def solve_linear_scalar(residual: ca.SX, var: ca.SX,
         return None
     if variables is not None and any(s.element_hash() in variables for s in ca.symvar(a)):
         return None
+    if discrete and may_vanish(a, discrete):
+        return None
     b = ca.substitute(residual, var, ca.SX(0))
     return -b / a
+
+
+#: :func:`may_vanish` tries every 0/1 combination of up to this many discrete symbols
+MAX_BRANCH_SYMBOLS = 8
+
+
+def may_vanish(coefficient: ca.SX, discrete: frozenset[int]) -> bool:
+    """Whether ``coefficient`` is identically zero for some 0/1 values of the symbols in it
+    whose element hash is in ``discrete`` (relation values, modes: the branch selectors of
+    piecewise expressions). Exact up to :data:`MAX_BRANCH_SYMBOLS` such symbols (each
+    combination is substituted and folded to a constant or not); beyond, any dependence on
+    them counts as vanishing."""
+    syms = [s for s in ca.symvar(coefficient) if s.element_hash() in discrete]
+    if not syms:
+        return False
+    if len(syms) > MAX_BRANCH_SYMBOLS:
+        return True
+    column = ca.vertcat(*syms)
+    n = len(syms)
+    for k in range(2 ** n):
+        value = ca.DM([(k >> i) & 1 for i in range(n)])
+        if ca.substitute(coefficient, column, value).is_zero():
+            return True
+    return False
 
 
 def solve_linear_block(residuals: Sequence[ca.SX], vars_: Sequence[ca.SX],
@@ -266,3 +294,37 @@ def _coloring(n: int, rows: Sequence[Sequence[int]]) -> np.ndarray:
         c += 1
     color[color < 0] = c                        # no uncolored neighbour left
     return color
+
+
+def fails_in_branch(residuals: Sequence[ca.SX], unknowns: Sequence[ca.SX], solution: ca.SX,
+                    discrete: frozenset[int], tries: int = 2 ** MAX_BRANCH_SYMBOLS) -> bool:
+    """Whether the symbolic ``solution`` of a block linear in ``unknowns`` divides by zero in
+    some branch where the block itself is regular: at random values of the other symbols,
+    for every 0/1 combination of the ``discrete`` ones in its matrix (at most ``tries``,
+    sampled beyond), the matrix has full rank but the solution is not finite."""
+    r, v = ca.vertcat(*residuals), ca.vertcat(*unknowns)
+    a = ca.jacobian(r, v)
+    if not any(s.element_hash() in discrete for s in ca.symvar(a)):
+        return False
+    b = ca.substitute(r, v, ca.DM.zeros(v.numel()))
+    syms = ca.symvar(ca.vertcat(ca.vec(a), b, solution))
+    f = ca.Function("bgm_branch", [ca.vertcat(*syms)], [a, b, solution])
+    in_a = {s.element_hash() for s in ca.symvar(a)}
+    picked = np.array([s.element_hash() in discrete and s.element_hash() in in_a
+                       for s in syms])
+    other_discrete = np.array([s.element_hash() in discrete for s in syms]) & ~picked
+    n = int(picked.sum())
+    rng = np.random.default_rng(2024)
+    combos = range(2 ** n) if 2 ** n <= tries else rng.integers(0, 2 ** n, tries).tolist()
+    x = rng.uniform(0.5, 1.5, len(syms))
+    x[other_discrete] = rng.integers(0, 2, int(other_discrete.sum()))
+    for k in combos:
+        x[picked] = [(k >> i) & 1 for i in range(n)]
+        with np.errstate(all="ignore"):
+            m, rhs, sol = (np.asarray(y, dtype=float) for y in f(x))
+        if not (np.all(np.isfinite(m)) and np.all(np.isfinite(rhs))) \
+                or np.linalg.matrix_rank(m) < v.numel():
+            continue
+        if not np.all(np.isfinite(sol)):
+            return True
+    return False

@@ -51,6 +51,7 @@ EXAMPLES = ["Mechanics.Rotational.Examples.First",
             "Blocks.Examples.IntegerNetwork1",
             "Blocks.Examples.BooleanNetwork1",
             "Electrical.Analog.Examples.AD_DA_conversion",
+            "Electrical.Analog.Examples.InvertingAmp",
             "Electrical.Analog.Examples.GenerationOfFMUs",
             "Thermal.HeatTransfer.Examples.GenerationOfFMUs"]
 
