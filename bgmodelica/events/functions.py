@@ -38,6 +38,8 @@ class HybridFunctions:
     #: bool per branch: its condition mentions initial() (it fires at initialization even
     #: when the rest of the condition is already true, as in ``when {c, initial()}``)
     initial_branch: np.ndarray | None = None
+    #: the algebraic residual, (z, [t, x, p]) -> alg (DAE models only)
+    alg: ca.Function | None = None
 
     @property
     def relations(self):
@@ -103,7 +105,7 @@ def build(dae: CasadiDAE) -> HybridFunctions:
                        ["t", "x", "z", "p"],
                        ["g", "dgdt", "cond", "assign", "reinit", "pre", "obs"])
     indicators = ca.Function("indicators", [t, x, z, p], [ca.densify(g_state)])
-    alg_solver = None
+    alg_solver = g = None
     if z.numel():
         g = ca.Function("alg", [z, ca.vertcat(t, x, p)], [dae.alg])
         alg_solver = ca.rootfinder("alg_solve", "newton", g,
@@ -114,12 +116,29 @@ def build(dae: CasadiDAE) -> HybridFunctions:
         np.array([r.strict for r in rels], dtype=bool), indicators, step,
         branch_of, assign_of, reinit_of,
         np.array([nb + slot for slot, _ in hyb.pre], dtype=int),
-        np.array(pre_disc, dtype=bool), np.array(discrete_obs, dtype=int), alg_solver)
+        np.array(pre_disc, dtype=bool), np.array(discrete_obs, dtype=int), alg_solver,
+        alg=g)
     if hyb.initial >= 0 and conds:
         init_sym = p[nb + hyb.initial]
         out.initial_branch = np.array([bool(ca.depends_on(c, init_sym)) for c in conds])
     dae.cache["hybrid"] = out
     return out
+
+
+def solve_algebraic(fn: HybridFunctions, guess, args: np.ndarray) -> np.ndarray:
+    """The algebraic variables for ``args`` = [t, x, p] by Newton's method from ``guess``;
+    where it fails, the guess itself when its residual is the smaller (IDAS starts from it)."""
+    z = np.asarray(fn.alg_solver(guess, args)).ravel()
+    if not fn.alg_solver.stats()["success"] and _size(fn.alg(guess, args)) < _size(
+            fn.alg(z, args)):
+        return np.array(guess, dtype=float)
+    return z
+
+
+def _size(r) -> float:
+    """Largest magnitude of a residual (inf when not finite)."""
+    r = np.asarray(r, dtype=float).ravel()
+    return float(np.max(np.abs(r), initial=0.0)) if np.all(np.isfinite(r)) else np.inf
 
 
 def _value_of(dae: CasadiDAE, name: str) -> tuple[ca.SX, bool]:

@@ -33,7 +33,7 @@ from ..errors import SimulationError
 from . import mixed
 from .crossings import CrossingMixin
 from .fast import Fast
-from .functions import HybridFunctions, build
+from .functions import HybridFunctions, build, solve_algebraic
 from .integrators import integrator as _integrator
 from .integrators import quiet_stderr as _quiet_stderr
 from .schedule import is_sample_instant, next_sample, table_coefficients
@@ -387,13 +387,15 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
             return init.x0, init.z0
         return x, self._solve_z(t, x)
 
-    def _solve_z(self, t: float, x) -> np.ndarray:
+    def _solve_z(self, t: float, x, guess=None) -> np.ndarray:
+        """Algebraic variables at (t, x) from ``guess`` (at an event the values just before
+        it), else from the last solution or the start values (see :func:`.solve_algebraic`)."""
         if self.fn.alg_solver is None:
             return np.zeros(0)
-        guess = getattr(self, "_z_guess", None)
-        if guess is None or len(guess) != self.dae.z.numel():
-            guess = self.dae.z_start
-        z = np.asarray(self.fn.alg_solver(guess, np.concatenate([[t], x, self.p]))).ravel()
+        for g in (guess, getattr(self, "_z_guess", None), self.dae.z_start):
+            if g is not None and len(g) == self.dae.z.numel():
+                break
+        z = solve_algebraic(self.fn, g, np.concatenate([[t], x, self.p]))
         self._z_guess = z
         return z
 
@@ -445,7 +447,7 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
         cycle = _Cycle(len(fn.rel_slot))
         for _ in range(self.opts.max_iterations):
             if fn.alg_solver is not None:
-                z = self._solve_z(t, x)
+                z = self._solve_z(t, x, z)
             out = self._step(t, x, z)
             g, dgdt, cond, assign, reinit, pre_src, _ = out
             changing = []

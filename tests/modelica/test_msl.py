@@ -53,7 +53,11 @@ EXAMPLES = ["Mechanics.Rotational.Examples.First",
             "Electrical.Analog.Examples.AD_DA_conversion",
             "Electrical.Analog.Examples.InvertingAmp",
             "Electrical.Analog.Examples.GenerationOfFMUs",
-            "Thermal.HeatTransfer.Examples.GenerationOfFMUs"]
+            "Thermal.HeatTransfer.Examples.GenerationOfFMUs",
+            # transistors whose junction currents are exponential: the algebraic loop is
+            # re-solved at each source kink from the values just before it
+            "Electrical.Analog.Examples.HeatingNPN_NORGate",
+            "Electrical.Analog.Examples.HeatingPNP_NORGate"]
 
 
 @pytest.mark.parametrize("name", EXAMPLES)
