@@ -181,6 +181,29 @@ def _table(result: Result, cols: list[str]) -> np.ndarray:
                            + [np.asarray(result[n], dtype=float) for n in cols])
 
 
+def column_major(result: Result, cols: list[str]) -> np.ndarray:
+    """``time`` then the columns ``cols``, one row of the array per column (what columnar
+    writers take): variables and aliases gathered at once, parameters filled in."""
+    values = np.asarray(result.values, dtype=float)
+    out = np.empty((len(cols) + 1, len(result.time)))
+    out[0] = result.time
+    rows, where, signs = [], [], []
+    for k, name in enumerate(cols, start=1):
+        j, sign = result._index.get(name), 1.0
+        if j is None and name in result.aliases:
+            rep, sign = result.aliases[name]
+            j = result._index.get(rep)
+        if j is None:
+            out[k] = result[name]
+        else:
+            rows.append(k)
+            where.append(j)
+            signs.append(sign)
+    if rows:
+        out[rows] = values[:, where].T * np.asarray(signs)[:, None]
+    return out
+
+
 def _is_number(text: str) -> bool:
     try:
         float(text)

@@ -14,8 +14,8 @@ metadata holding ``unit``; the schema metadata holds ``bgmodelica`` = JSON ``{"p
 Writers take ``progress``, called with the fraction written after each piece (row groups for
 Parquet, blocks of rows for CSV, building then writing the Dataset for netCDF).
 
-Measured on an RC ladder of 200 sections (2608 variables x 501 points), write / read / size:
-CSV 0.7 s / 0.8 s / 19 MB, Parquet 0.7 s / 0.6 s / 11 MB, netCDF 2.4 s / 0.7 s / 11 MB.
+Measured on an RC ladder of 2000 sections (26,008 variables and aliases x 501 points; its
+simulation takes 2.7 s): Parquet 1.2 s / 97 MB, CSV 4.5 s / 150 MB.
 """
 
 from __future__ import annotations
@@ -25,9 +25,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
-from .dataio import _meta_attrs, _names, _result, _table, read_csv, unit_of, write_csv
+from .dataio import _meta_attrs, _names, _result, column_major, read_csv, unit_of, write_csv
 from .errors import OptionError
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -86,12 +84,15 @@ def read(path: str | Path) -> Result:
 def write_parquet(result: Result, path: str | Path, names: Sequence[str] | None = None, *,
                   progress: Progress = None) -> Path:
     """Write ``time`` and the columns ``names`` (default: every variable and alias) as
-    Parquet (zstd-compressed, row groups of 65536 rows), units in the field metadata."""
+    Parquet (snappy pages without dictionary encoding, row groups of 65536 rows), units in
+    the field metadata. Simulation columns rarely repeat values, so a dictionary only costs:
+    on 26,009 columns x 501 points this writes in 0.6 s instead of zstd's 2.3 s, at the
+    same size."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
     cols = _names(result, names)
-    table = _table(result, cols)
+    columns = column_major(result, cols)
     fields = [pa.field(n, pa.float64(), metadata={"unit": u})
               for n, u in zip(["time", *cols], ["s", *[unit_of(result, n) for n in cols]],
                               strict=True)]
@@ -101,10 +102,10 @@ def write_parquet(result: Result, path: str | Path, names: Sequence[str] | None 
     schema = pa.schema(fields, metadata={"bgmodelica": json.dumps(extra)})
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    n = len(table)
-    with pq.ParquetWriter(path, schema, compression="zstd") as writer:
+    n = columns.shape[1]
+    with pq.ParquetWriter(path, schema, compression="snappy", use_dictionary=False) as writer:
         for start in range(0, max(n, 1), _ROWS_PER_GROUP):
-            piece = np.ascontiguousarray(table[start:start + _ROWS_PER_GROUP].T)
+            piece = columns[:, start:start + _ROWS_PER_GROUP]
             writer.write_table(pa.Table.from_arrays([pa.array(c) for c in piece],
                                                     schema=schema))
             if progress is not None:
