@@ -1,16 +1,19 @@
 """The CasADi integrators of the event loop (CVODES for ODEs, IDAS for DAEs), built once per
-settings and reused for every segment, and a guard that keeps SUNDIALS' own error messages
-off the terminal while a failure is expected and retried."""
+settings and reused for every segment, the segments between events, and a guard that keeps
+SUNDIALS' own error messages off the terminal while a failure is expected and retried."""
 
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import sys
 
 import casadi as ca
+import numpy as np
 
 from ..backends.casadi_dae import CasadiDAE
+from .fast import Fast
 
 
 @contextlib.contextmanager
@@ -60,3 +63,133 @@ def integrator(dae: CasadiDAE, opts: dict, tout: list[float], scaled: bool) -> c
     if scaled:
         dae.cache[key] = F
     return F
+
+
+class SegmentMixin:
+    """Continuous phases of the event loop: integrate a segment through its output points
+    up to the first state event (mixed into :class:`~.loop.HybridSimulator`)."""
+
+    def _advance(self, t0: float, t1: float, x, z, outs: np.ndarray):
+        """Integrate from t0 to t1 through the output points ``outs`` (inside (t0, t1));
+        stop at the first state event. Returns (t, x, z, cause or None, output rows)."""
+        fn = self.fn
+        if t1 <= t0:
+            return t0, x, z, None, []
+        sel = self.selection
+        outs = np.asarray(outs, dtype=float)
+        if not fn.state_rel and len(outs) == 0 and sel is None:
+            xf, zf = self._integrate_one(t0, t1, x, z)
+            return t1, xf, zf, None, []
+        checks = self.opts.checks if fn.state_rel else 1
+        if sel is not None:
+            checks = max(checks, int(math.ceil((t1 - t0) / sel.spacing - 1e-9)))
+        out_offsets = outs - t0
+        uniform = (t1 - t0) * np.arange(1, checks + 1) / checks
+        if len(out_offsets):      # a check a rounding error from an output point is that point
+            i = np.searchsorted(out_offsets, uniform[:-1]).clip(1, len(outs) - 1)
+            pick = np.where(uniform[:-1] - out_offsets[i - 1] < out_offsets[i] - uniform[:-1],
+                            out_offsets[i - 1], out_offsets[i]) if len(outs) > 1 else out_offsets
+            close = np.abs(uniform[:-1] - pick) <= 1e-9 * (t1 - t0)
+            uniform[:-1] = np.where(close, pick, uniform[:-1])
+        offsets = np.union1d(out_offsets, uniform)
+        offsets = offsets[offsets > 0]
+        retry = (sel is not None or bool(fn.state_rel)) and t1 - t0 >= 1e-12 * max(1.0, abs(t0))
+        try:
+            if not retry:
+                X, Z = self._columns(t0, x, z, offsets)
+            else:        # a failure is expected now and then (retried): keep SUNDIALS quiet
+                with quiet_stderr():
+                    X, Z = self._columns(t0, x, z, offsets, self._retry_opts)
+        except RuntimeError:
+            # with dynamic state selection the current choice may fail before the next pivot
+            # check, and a branch kept past a crossing not yet checked may be singular (a
+            # force ~ 1/v beyond the switch to its regularization): integrate a shorter
+            # stretch, whose checks switch in time
+            if not retry:
+                raise
+            t_short = t0 + 0.25 * (t1 - t0)
+            self._stretch = t_short - t0
+            return self._advance(t0, t_short, x, z, outs[outs < t_short])
+        self._stretch = 2 * self._stretch if t1 - t0 >= self._stretch else self._stretch
+        nz = self.dae.z.numel()
+        ts = t0 + offsets
+        out_cols = np.searchsorted(offsets, out_offsets)
+        inside = out_offsets > 0
+        ts[out_cols[inside]] = outs[inside]        # output times exactly as requested
+        ts[-1] = t1
+        last = len(offsets)
+        crossing = None
+        if fn.state_rel:
+            G = np.asarray(self._ind_map(last)(ts.reshape(1, -1), X, Z, self.p))
+            frozen = self.p[fn.rel_slot[fn.state_rel]].astype(bool)
+            cols = np.nonzero(self._crossed(G, frozen).any(axis=0))[0]
+            if cols.size:
+                j = int(cols[0])
+                last = j
+                lo = (t0, x, z) if j == 0 else (float(ts[j - 1]), X[:, j - 1],
+                                                   Z[:, j - 1] if nz else z)
+                g_lo = self._ind(*lo) if j == 0 else G[:, j - 1]
+                crossing = self._locate(lo[0], lo[1], lo[2], g_lo, float(ts[j]), X[:, j],
+                                        Z[:, j] if nz else z, G[:, j], frozen)
+        if sel is not None:
+            cols = np.searchsorted(offsets, uniform)
+            stop_col = self._selection_column(ts, X, Z, z, cols[cols < last])
+            if stop_col is not None:
+                crossing = (float(ts[stop_col]), X[:, stop_col],
+                            Z[:, stop_col] if nz else z, "select")
+                last = stop_col + 1
+        passed = []
+        for k, c in enumerate(out_cols):
+            if c < last and out_offsets[k] > 0:
+                tk = float(outs[k])
+                passed.append((tk, self._obs(tk, X[:, c], Z[:, c] if nz else z)))
+        if crossing is not None:
+            return (*crossing[:3], crossing[3], passed)
+        return t1, X[:, -1], Z[:, -1] if nz else z, None, passed
+
+    def _columns(self, t0: float, x, z, offsets: np.ndarray, opts: dict | None = None):
+        """States and algebraic variables at ``t0 + offsets`` (one integrator call with the
+        solver options ``opts``, by default the run's, or algebraic solves for a model without
+        states)."""
+        nz = self.dae.z.numel()
+        n_t = len(offsets)
+        if len(x) == 0:
+            Z = np.zeros((nz, n_t))
+            for c, off in enumerate(offsets):
+                Z[:, c] = self._solve_z(t0 + float(off), x)
+            return np.zeros((0, n_t)), Z
+        F = self._shifted(tuple(offsets), opts or self._sol_opts)
+        res = F(x, z, np.concatenate([self.p, [t0]]))
+        self.n_segments += 1
+        X = res[0].reshape(n_t, len(x)).T.copy()
+        Z = res[1].reshape(n_t, nz).T.copy() if nz else np.zeros((0, n_t))
+        return X, Z
+
+    def _shifted(self, offsets: tuple[float, ...], opts: dict) -> Fast:
+        """An integrator from t0 (a parameter) to ``t0 + offsets`` (cached by options)."""
+        key = ("shifted", tuple(sorted((k, repr(v)) for k, v in opts.items())))
+        cache = self.dae.cache.setdefault(key, {})
+        if len(offsets) > 64:                       # long runs: not worth keeping
+            return Fast(integrator(self.dae, opts, list(offsets), scaled=False))
+        F = cache.get(offsets)
+        if F is None:
+            if len(cache) > 64:
+                cache.pop(next(iter(cache)))
+            F = Fast(integrator(self.dae, opts, list(offsets), scaled=False))
+            cache[offsets] = F
+        return F
+
+    def _integrate_one(self, t0, t1, x, z):
+        if len(x) == 0:
+            return x, self._solve_z(t1, x)
+        if self._one is None:
+            self._one = Fast(integrator(self.dae, self._sol_opts, [1.0], scaled=True))
+            self._pe = np.zeros(len(self.p) + 2)
+        pe = self._pe
+        pe[:-2] = self.p
+        pe[-2], pe[-1] = t0, t1 - t0
+        res = self._one(x, z, pe)
+        self.n_segments += 1
+        return res[0].copy(), (res[1].copy() if self.dae.z.numel() else z)
+
+    # -- time events ------------------------------------------------------------------------
