@@ -124,9 +124,9 @@ def _source_input(compiled, node: str) -> tuple[str | None, str]:
     name = f"{node}.u"
     if name in inputs:
         return name, ""
-    from ..simulate import _resolve_alias
+    from ..overrides import resolve_alias
 
-    kept, _ = _resolve_alias(name, dae.aliases, free | inputs, dae.observed_index)
+    kept, _ = resolve_alias(name, dae.aliases, free | inputs, dae.observed_index)
     if kept in inputs or kept in free:
         return kept, ""
     if kept in dae.observed_index:

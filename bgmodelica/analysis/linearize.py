@@ -213,13 +213,13 @@ def _input_slots(dae, inputs: Sequence[str] | None) -> tuple[list[int], list[str
             seen.add(key)
             key = dae.aliases[key][0]
         if key not in where:
-            from ..simulate import _did_you_mean
+            from ..overrides import did_you_mean
 
             if name in bound:
                 raise ParameterError(f"input {name!r}: the parameter is bound to an expression "
                                      "of other parameters; perturb those instead")
             raise ParameterError(f"input {name!r} is not an input or free parameter of the "
-                                 f"model{_did_you_mean(name, list(where))}")
+                                 f"model{did_you_mean(name, list(where))}")
         idx.append(where[key])
         names.append(name)
     return idx, names
@@ -238,7 +238,7 @@ def top_level_outputs(compiled) -> list[str]:
 
 
 def _outputs(compiled, dae, outputs: Sequence[str] | None) -> tuple[ca.SX, list[str]]:
-    from ..simulate import _did_you_mean, _resolve_alias
+    from ..overrides import did_you_mean, resolve_alias
 
     names = list(outputs) if outputs is not None else top_level_outputs(compiled)
     if outputs is None and not names:
@@ -246,9 +246,9 @@ def _outputs(compiled, dae, outputs: Sequence[str] | None) -> tuple[ca.SX, list[
     rows = []
     n_var = dae.n_variables or len(dae.names)
     for name in names:
-        kept, sign = _resolve_alias(name, dae.aliases, set(), dae.observed_index)
+        kept, sign = resolve_alias(name, dae.aliases, set(), dae.observed_index)
         if kept not in dae.observed_index or dae.observed_index[kept] >= n_var:
             raise ParameterError(f"output {name!r} is not a variable of the model"
-                                 f"{_did_you_mean(name, dae.names[:n_var])}")
+                                 f"{did_you_mean(name, dae.names[:n_var])}")
         rows.append(float(sign) * dae.observed[dae.observed_index[kept]])
     return (ca.vertcat(*rows) if rows else ca.SX(0, 1)), names

@@ -17,9 +17,9 @@ from ..errors import InitializationError, ParameterError
 
 def state_name(dae: CasadiDAE, name: str) -> str:
     """The state that ``name`` (a state or an alias of one) is; a clear error otherwise."""
-    from ..simulate import _resolve_alias
+    from ..overrides import resolve_alias
 
-    kept, _ = _resolve_alias(name, dae.aliases, set(), dae.observed_index)
+    kept, _ = resolve_alias(name, dae.aliases, set(), dae.observed_index)
     if kept not in dae.state_names:
         raise ParameterError(f"exclude: {name!r} is not a state of the model (states: "
                              f"{', '.join(dae.state_names) or 'none'})")

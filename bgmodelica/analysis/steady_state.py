@@ -112,10 +112,10 @@ class OperatingPoint:
     def __getitem__(self, name: str) -> float:
         vals = self.values
         if name not in vals:
-            from ..simulate import _did_you_mean
+            from ..overrides import did_you_mean
 
             raise KeyError(f"no variable {name!r} at the operating point"
-                           f"{_did_you_mean(name, list(vals))}")
+                           f"{did_you_mean(name, list(vals))}")
         return vals[name]
 
     def to_dict(self) -> dict[str, Any]:
@@ -168,7 +168,8 @@ def operating_point(model: Any, params: dict[str, Any] | None = None, *, steady:
     expressed in the states whose pivots are best there."""
     from ..compiler import CompiledModel, compile
     from ..core.units import with_units
-    from ..simulate import _selector, _split_overrides, _with_starts
+    from ..overrides import split_overrides, with_starts
+    from ..simulate import _selector
     from ..value_checks import check_values
 
     if steady and at_time is not None:
@@ -177,14 +178,14 @@ def operating_point(model: Any, params: dict[str, Any] | None = None, *, steady:
     compiled = model if isinstance(model, CompiledModel) else compile(model, units=units)
     params = with_units(dict(params or {}), compiled)
     dae0 = compiled.dae
-    p_over, start_over = _split_overrides(dae0, params)
+    p_over, start_over = split_overrides(dae0, params)
     p = dae0.p_vector(p_over)
     check_values(dae0, p, compiled.reduced.model)
     selector = _selector(compiled)
     if at_time is not None:
         return _at_time(compiled, params, float(at_time), t, selector, simulate_options or {})
     if not steady:
-        dae = _with_starts(dae0, start_over) if start_over else dae0
+        dae = with_starts(dae0, start_over) if start_over else dae0
         init = initialize(dae, p, t)
         point = OperatingPoint(compiled, dae, p, t, init.x0, init.z0, "start values",
                                list(init.notes))
@@ -359,12 +360,13 @@ def _reselect(point: OperatingPoint, selector, p, t) -> OperatingPoint:
 
 
 def _at_time(compiled, params, at_time: float, t0: float, selector, options) -> OperatingPoint:
-    from ..simulate import _split_overrides, simulate
+    from ..overrides import split_overrides
+    from ..simulate import simulate
 
     if at_time < t0:
         raise ParameterError(f"at_time ({at_time:g} s) is before the start time ({t0:g} s)")
     dae = compiled.dae
-    p_over, _ = _split_overrides(dae, params)
+    p_over, _ = split_overrides(dae, params)
     p = dae.p_vector(p_over)
     if at_time == t0:
         return operating_point(compiled, params, t=t0)

@@ -95,7 +95,7 @@ def make_problem(compiled: Any, controls: Mapping[str, Bounds | None] | Sequence
     """Check the request against the model and build the :class:`Problem`."""
     from ..backends.casadi_init import initialize
     from ..core.units import with_units
-    from ..simulate import _split_overrides, _with_starts
+    from ..overrides import split_overrides, with_starts
     from .expression import parse_expression
 
     dae = compiled.dae
@@ -126,9 +126,9 @@ def make_problem(compiled: Any, controls: Mapping[str, Bounds | None] | Sequence
         raise ParameterError(f"stop time {stop_time}: must be a positive finite time")
 
     params = with_units(dict(params or {}), compiled)
-    p_over, start_over = _split_overrides(dae, params)
+    p_over, start_over = split_overrides(dae, params)
     given = {str(k): float(v) for k, v in (initial or {}).items()}
-    p_init, start_init = _split_overrides(dae, given)
+    p_init, start_init = split_overrides(dae, given)
     if p_init:
         raise ParameterError(f"initial value {next(iter(p_init))!r}: not a variable of the "
                              f"model (set parameters with --set)")
@@ -136,7 +136,7 @@ def make_problem(compiled: Any, controls: Mapping[str, Bounds | None] | Sequence
     for k, (lo, hi) in zip(slots, bounds, strict=True):   # a feasible start for the warm run
         p[k] = float(np.clip(p[k], lo, hi))
     start_all = {**start_over, **start_init}
-    init_dae = _with_starts(dae, start_all) if start_all else dae
+    init_dae = with_starts(dae, start_all) if start_all else dae
     init = initialize(init_dae, p, 0.0)
 
     lookup = _lookup(compiled, p, slots)
@@ -157,7 +157,7 @@ def make_problem(compiled: Any, controls: Mapping[str, Bounds | None] | Sequence
 
 def _lookup(compiled: Any, p: np.ndarray, slots: list[int]):
     """``name -> SX`` over the compiled model's variables, parameters and inputs."""
-    from ..simulate import _did_you_mean, _resolve_alias
+    from ..overrides import did_you_mean, resolve_alias
 
     dae = compiled.dae
     n_var = dae.n_variables or len(dae.names)
@@ -168,7 +168,7 @@ def _lookup(compiled: Any, p: np.ndarray, slots: list[int]):
     def lookup(name: str) -> ca.SX:
         if name == "time":
             return dae.t
-        kept, sign = _resolve_alias(name, dae.aliases, set(pindex), dae.observed_index)
+        kept, sign = resolve_alias(name, dae.aliases, set(pindex), dae.observed_index)
         if kept in pindex:
             return sign * dae.p[pindex[kept]]
         if kept in dae.observed_index and dae.observed_index[kept] < n_var:
@@ -177,6 +177,6 @@ def _lookup(compiled: Any, p: np.ndarray, slots: list[int]):
             return ca.SX(sign * bound[kept])
         raise ParameterError(f"{name!r} is not a variable, parameter or input of "
                              f"{compiled.name}"
-                             f"{_did_you_mean(name, dae.names[:n_var] + pnames)}")
+                             f"{did_you_mean(name, dae.names[:n_var] + pnames)}")
 
     return lookup

@@ -309,17 +309,17 @@ def fit(model: Any, data: Any, free: Any, *, params: Mapping[str, Any] | None = 
 
 def _p_only(dae: Any, params: dict[str, Any], compiled: Any) -> dict[str, Any]:
     from ..core.units import with_units
-    from ..simulate import _split_overrides
+    from ..overrides import split_overrides
 
-    p_over, _starts = _split_overrides(dae, with_units(params, compiled))
+    p_over, _starts = split_overrides(dae, with_units(params, compiled))
     return p_over
 
 
 def _resolve_column(dae: Any, name: str) -> tuple[str, float] | None:
-    from ..simulate import _resolve_alias
+    from ..overrides import resolve_alias
 
     pset = {q.name for q in dae.parameters} | {u.name for u in dae.inputs}
-    kept, sign = _resolve_alias(name, dae.aliases or {}, pset, dae.observed_index)
+    kept, sign = resolve_alias(name, dae.aliases or {}, pset, dae.observed_index)
     if kept in dae.observed_index:
         return kept, sign
     return None
@@ -329,7 +329,7 @@ def _prepare(compiled: Any, exp: Experiment, k: int, params: dict[str, Any],
              weights: Mapping[str, float] | None, free: list[str], start_time: float,
              use_fd: bool) -> _Prepared:
     from ..core.units import with_units
-    from ..simulate import _did_you_mean, _split_overrides, _with_starts
+    from ..overrides import did_you_mean, split_overrides, with_starts
 
     dae = compiled.dae
     name = exp.name or (Path(exp.data).name if isinstance(exp.data, (str, Path))
@@ -344,7 +344,7 @@ def _prepare(compiled: Any, exp: Experiment, k: int, params: dict[str, Any],
         if res is None:
             known = list(dae.names[:dae.n_variables or len(dae.names)]) + list(dae.aliases)
             raise FitError(f"{name}: column {c!r} is not a variable of {compiled.name}"
-                           f"{_did_you_mean(c, known)}")
+                           f"{did_you_mean(c, known)}")
         columns.append(c)
         keep.append(dae.observed_index[res[0]])
         col_pos.append(res)
@@ -354,9 +354,9 @@ def _prepare(compiled: Any, exp: Experiment, k: int, params: dict[str, Any],
     clash = [f for f in free if f in all_params]
     if clash:
         raise FitError(f"{name}: {clash[0]!r} is both free and set to a value")
-    p_over, start_over = _split_overrides(dae, all_params)
+    p_over, start_over = split_overrides(dae, all_params)
     p = dae.p_vector(p_over)
-    dae_e = _with_starts(dae, start_over) if start_over else dae
+    dae_e = with_starts(dae, start_over) if start_over else dae
     grid = times if abs(times[0] - t0) <= 1e-12 * max(1.0, abs(t0)) \
         else np.concatenate([[t0], times])
     rows = np.arange(len(grid) - len(times), len(grid))

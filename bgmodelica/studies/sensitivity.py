@@ -40,7 +40,7 @@ class SensitivityError(ModelError):
 
 def parameter_indices(dae: Any, names: Sequence[str]) -> list[int]:
     """Positions in ``p`` of the parameters / inputs ``names`` (aliases followed)."""
-    from ..simulate import _did_you_mean, _resolve_alias
+    from ..overrides import did_you_mean, resolve_alias
 
     pnames = [q.name for q in dae.parameters] + [u.name for u in dae.inputs]
     pset = set(pnames)
@@ -50,7 +50,7 @@ def parameter_indices(dae: Any, names: Sequence[str]) -> list[int]:
     if not list(names):
         raise SensitivityError("sensitivities: name at least one parameter")
     for key in names:
-        name, _sign = _resolve_alias(key, dae.aliases or {}, pset, dae.observed_index)
+        name, _sign = resolve_alias(key, dae.aliases or {}, pset, dae.observed_index)
         if name not in pset:
             if name in dae.observed_index:
                 raise SensitivityError(
@@ -63,7 +63,7 @@ def parameter_indices(dae: Any, names: Sequence[str]) -> list[int]:
                     f"sensitivities: {key!r} is bound to an expression of other parameters; "
                     "take the sensitivities with respect to those")
             raise SensitivityError(f"sensitivities: {key!r} is not a parameter or input of "
-                                   f"the model{_did_you_mean(key, pnames)}")
+                                   f"the model{did_you_mean(key, pnames)}")
         if _sign != 1.0:
             raise SensitivityError(f"sensitivities: {key!r} is a negated alias of {name}; "
                                    f"use {name}")
@@ -335,8 +335,9 @@ def finite_difference_sensitivities(model: Any, names: Sequence[str], *, stop_ti
     from ..compiler import CompiledModel
     from ..compiler import compile as compile_model
     from ..core.units import with_units
+    from ..overrides import split_overrides
     from ..result import Result
-    from ..simulate import _split_overrides, simulate
+    from ..simulate import simulate
     from ..validate import output_grid
     from .sweeps import on_grid
 
@@ -345,7 +346,7 @@ def finite_difference_sensitivities(model: Any, names: Sequence[str], *, stop_ti
     params = with_units(dict(params or {}), compiled)
     wrt = parameter_indices(dae, names)
     pnames = [q.name for q in dae.parameters] + [u.name for u in dae.inputs]
-    p_over, _ = _split_overrides(dae, params)
+    p_over, _ = split_overrides(dae, params)
     p = dae.p_vector(p_over)
     if grid is None:
         grid = output_grid(start_time, stop_time, interval)

@@ -387,7 +387,8 @@ def _check_names(compiled, outputs, fixed, grid, distributions):
     """Validate output and parameter names against the compiled model (before any run);
     returns the outputs, a function giving a parameter's value in the model, and units."""
     from ..core.units import with_units
-    from ..simulate import _output_indices, _split_overrides
+    from ..overrides import split_overrides
+    from ..simulate import _output_indices
 
     dae = compiled.dae
     if outputs is None:
@@ -397,7 +398,7 @@ def _check_names(compiled, outputs, fixed, grid, distributions):
         raise OptionError("no outputs to record")
     _output_indices(dae, outputs, compiled.reduced.model.aliases)
     varied = {n: 0.0 for n in [*(grid or {}), *(distributions or {})]}
-    _split_overrides(dae, {**with_units(dict(fixed), compiled), **varied})
+    split_overrides(dae, {**with_units(dict(fixed), compiled), **varied})
     pnames = [q.name for q in dae.parameters] + [u.name for u in dae.inputs]
     p_fixed = dae.p_vector({k: v for k, v in with_units(dict(fixed), compiled).items()
                             if k in pnames})
