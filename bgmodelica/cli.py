@@ -56,13 +56,9 @@ def _progress(frac: float) -> None:
 def _check_simulate_args(args: argparse.Namespace) -> None:
     """Options and output files, before any model is loaded (nothing is written)."""
     from .errors import OptionError
+    from .output_checks import check_distinct_outputs, check_output_file, check_plot_file
     from .result_files import format_of
-    from .validate import (
-        check_distinct_outputs,
-        check_output_file,
-        check_plot_file,
-        check_run_options,
-    )
+    from .validate import check_run_options
 
     check_run_options(stop_time=args.stop_time, interval=args.interval, rtol=args.rtol,
                       atol=args.atol)
@@ -83,9 +79,9 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     from .errors import SimulationError
     from .loader import load_model
     from .modelica.cli import apply_experiment_defaults
+    from .output_checks import check_distinct_outputs, check_output_file, check_plot_vars
     from .result_files import save, write_progress
     from .simulate import simulate
-    from .validate import check_distinct_outputs, check_output_file, check_plot_vars
 
     apply_experiment_defaults(args)        # .mo models: experiment annotation defaults
     _check_simulate_args(args)
@@ -98,7 +94,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         check_distinct_outputs(("-o", out), ("--plot", args.plot))
     if args.plot_vars:
         check_plot_vars(args.plot_vars, compiled)
-    from .validate import expand_outputs
+    from .output_checks import expand_outputs
 
     outputs = expand_outputs(args.outputs, compiled) if args.outputs else None
     if outputs is not None and args.plot_vars:
@@ -227,7 +223,7 @@ def cmd_export(args: argparse.Namespace) -> int:
 def cmd_draw(args: argparse.Namespace) -> int:
     from .bondgraph import BondGraph, draw
     from .loader import load_model
-    from .validate import check_plot_file
+    from .output_checks import check_plot_file
 
     check_plot_file(args.output, "-o")
     model = load_model(args.model, **_model_kwargs(args.arg))

@@ -40,7 +40,7 @@ def register(sub: Any, model_args: Any) -> None:
 
 def _check_args(args: argparse.Namespace) -> None:
     from ..errors import OptionError
-    from ..validate import check_distinct_outputs, check_plot_file
+    from ..output_checks import check_distinct_outputs, check_plot_file
 
     if args.steady_state and args.at_time is not None:
         raise OptionError("--steady-state and --at-time exclude each other")

@@ -83,7 +83,7 @@ def _values(items: list[str], option: str) -> dict[str, float]:
 
 def _check_args(args: argparse.Namespace) -> None:
     from ..errors import OptionError
-    from ..validate import check_distinct_outputs, check_output_file, check_plot_file
+    from ..output_checks import check_distinct_outputs, check_output_file, check_plot_file
 
     if not args.control:
         raise OptionError("--control: name the inputs to optimize (--control U=-1:1)")

@@ -41,7 +41,7 @@ def _pairs(items: list[str], option: str) -> dict[str, str]:
 
 
 def _check_outputs(paths: list[str]) -> list[Path]:
-    from ..validate import check_distinct_outputs, check_output_file
+    from ..output_checks import check_distinct_outputs, check_output_file
 
     out = []
     for p in paths:
@@ -79,7 +79,8 @@ def _load(args: argparse.Namespace):
 
 def cmd_sweep(args: argparse.Namespace) -> int:
     from ..cli import _parse_sets
-    from ..validate import check_plot_file, check_run_options
+    from ..output_checks import check_plot_file
+    from ..validate import check_run_options
     from .cluster import check_scheduler
     from .sweeps import sweep
 
@@ -154,7 +155,7 @@ def _free(items: list[str]) -> dict[str, Any]:
 
 def cmd_fit(args: argparse.Namespace) -> int:
     from ..cli import _parse_sets
-    from ..validate import check_plot_file
+    from ..output_checks import check_plot_file
     from .fitting import Experiment, fit
 
     if not args.free:
