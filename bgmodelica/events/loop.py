@@ -33,7 +33,7 @@ from ..errors import SimulationError
 from . import mixed
 from .crossings import CrossingMixin
 from .fast import Fast
-from .functions import HybridFunctions, build
+from .functions import HybridFunctions, build, run_calls
 from .integrators import integrator as _integrator
 from .integrators import quiet_stderr as _quiet_stderr
 from .schedule import is_sample_instant, next_sample, table_coefficients
@@ -465,6 +465,10 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin):
                         fired.append(b)
                         break
             self.cond_pre = cond
+            if fn.calls is not None and any(fn.call_of[b] for b in fired):
+                run_calls(fn, t, x, z, self.p, fired)
+                out = self._step(t, x, z)
+                assign, reinit, pre_src = out[3], out[4], out[5]
             new_x, fixed = np.array(x, dtype=float), []
             for b in fired:
                 for pidx, pos in fn.assign_of[b]:
