@@ -326,10 +326,17 @@ def _external(fn: FunctionDef, local: dict, ctx: Ctx, node: Any) -> None:
                           "values known when the model is built)") from None
         raise fail(ctx.lex, node, f"{fn.name}(): {err}") from None
     if len(out_names) == 1:
-        local[out_names[0]] = got
+        local[out_names[0]] = _from_c(got)
     elif len(out_names) > 1:
         if not isinstance(got, tuple) or len(got) != len(out_names):
             raise fail(lex, ext, f"external {cname} returned {type(got).__name__}, expected "
                        f"{len(out_names)} outputs")
         for n, v in zip(out_names, got, strict=True):
-            local[n] = v
+            local[n] = _from_c(v)
+
+
+def _from_c(v: Any) -> Any:
+    """A numeric array result of a native implementation as the nested lists arrays are."""
+    import numpy as np
+
+    return v.tolist() if isinstance(v, np.ndarray) and v.dtype != object else v

@@ -16,6 +16,7 @@ from .. import scope as S
 from .arith import _flatten, _num_or_expr, _shape, _sum
 from .base import Ctx, NotConstant, check_array_size, fail, numeric_value
 from .evaluate import _comprehension, evaluate
+from .text import fn_string
 from .types import check_der_argument
 
 
@@ -475,7 +476,7 @@ _FUNCTIONS: dict[str, Any] = {
     "cardinality": _fn_unsupported("cardinality", "cardinality()"),
     "inStream": _fn_unsupported("inStream", "stream connectors (inStream)"),
     "actualStream": _fn_unsupported("actualStream", "stream connectors (actualStream)"),
-    "String": _fn_unsupported("String", "String() conversions"),
+    "String": fn_string,
     "connect": _fn_statement("connect"), "reinit": _fn_statement("reinit"),
     "assert": _fn_statement("assert"), "terminate": _fn_statement("terminate"),
 }
