@@ -289,6 +289,20 @@ class FlatBranch:
     text: str
     assignments: list[tuple[int, ca.SX]]
     reinits: list[tuple[str, ca.SX]]
+    #: functions run on numbers when the branch fires, before its assignments
+    calls: list[FlatCall] = field(default_factory=list)
+
+
+@dataclass
+class FlatCall:
+    """A :class:`~bgmodelica.core.hybrid.RuntimeCall` with its ``guard`` and ``args`` as SX
+    and its outputs as discrete slots."""
+
+    function: Any
+    args: list[ca.SX]
+    guard: ca.SX
+    outputs: list[int]
+    text: str
 
 
 @dataclass
@@ -342,6 +356,8 @@ class HybridPart:
             for b in w.branches:
                 out.append(b.condition)
                 out += [v for _, v in b.assignments] + [v for _, v in b.reinits]
+                for c in b.calls:
+                    out += [c.guard, *c.args]
         for s in self.samples:
             out += [s.start, s.interval]
         return out
@@ -358,7 +374,12 @@ class HybridPart:
                 cond = next(it)
                 assigns = [(s, next(it)) for s, _ in b.assignments]
                 reinits = [(n, next(it)) for n, _ in b.reinits]
-                branches.append(FlatBranch(cond, b.text, assigns, reinits))
+                calls = []
+                for c in b.calls:
+                    guard = next(it)
+                    calls.append(FlatCall(c.function, [next(it) for _ in c.args], guard,
+                                          list(c.outputs), c.text))
+                branches.append(FlatBranch(cond, b.text, assigns, reinits, calls))
             whens.append(FlatWhen(branches, w.origin))
         samples = [FlatSample(s.slot, next(it), next(it), s.origin) for s in self.samples]
         return HybridPart(rels, whens, samples, list(self.tables), list(self.pre),

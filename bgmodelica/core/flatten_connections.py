@@ -51,7 +51,7 @@ class ConnectionLowering:
                         raise ConnectError(
                             f"{self.where(ctx)}: connect() uses a {type(end).__name__} that is "
                             "not part of the model (add its component to the model first)")
-                    nodes.append(2 * k + (parents.get(id(end)) is ctx))
+                    nodes.append(2 * k + (_owner(end, parents) is ctx))
             if len(nodes) == 2:
                 heads.append(nodes[1])
                 tails.append(nodes[0])
@@ -174,6 +174,15 @@ def connection_set_arrays(n: int, heads: Any, tails: Any,
     order = np.lexsort((first, by_path[nodes >> 1], set_first[label]))
     nodes, label = nodes[order], label[order]
     return nodes, np.flatnonzero(label[1:] != label[:-1]) + 1
+
+
+def _owner(end: Connector, parents: dict) -> Any:
+    """The component ``end`` belongs to: its parent, or the parent of the connector that
+    holds it (a pin of a plug is an outside element in the plug owner's connects)."""
+    owner = parents.get(id(end))
+    while isinstance(owner, Connector):
+        owner = parents.get(id(owner))
+    return owner
 
 
 def _symbol(x: Any) -> Symbol:

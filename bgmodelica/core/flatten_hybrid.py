@@ -16,13 +16,22 @@ import casadi as ca
 
 from ..errors import EquationError
 from .expr import RELATIONS, Equation, Expr, Leaf, Op, to_sx, to_text
-from .flatmodel import FlatBranch, FlatRelation, FlatSample, FlatTable, FlatWhen, HybridPart
+from .flatmodel import (
+    FlatBranch,
+    FlatCall,
+    FlatRelation,
+    FlatSample,
+    FlatTable,
+    FlatWhen,
+    HybridPart,
+)
 from .hybrid import (
     _INITIAL,
     _TERMINAL,
     Assert,
     IfEquation,
     Reinit,
+    RuntimeCall,
     SampleClock,
     TimeTable,
     When,
@@ -83,6 +92,12 @@ def extract(pending: list[tuple[Any, Any]], where: Callable[[Any], str]
                 for s in stmts:
                     if isinstance(s, Reinit):
                         rw.scan(s.value, here, live=False)
+                        continue
+                    if isinstance(s, RuntimeCall):
+                        for e in (s.guard, *s.args):
+                            rw.scan(e, here, live=False)
+                        for o in s.outputs:
+                            draft.specials.setdefault(id(o), o)
                         continue
                     target = s.lhs.sym if isinstance(s.lhs, Leaf) else None
                     if not isinstance(target, Symbol) or not (
@@ -250,14 +265,18 @@ def lower(draft: HybridDraft, slot_of: Callable[[Symbol], int],
     for w, here in draft.whens:
         branches = []
         for cond, stmts in w.branches:
-            assigns, reinits = [], []
+            assigns, reinits, calls = [], [], []
             for s in stmts:
-                if isinstance(s, Reinit):
+                if isinstance(s, RuntimeCall):
+                    calls.append(FlatCall(s.function, [to_sx(a) for a in s.args],
+                                          to_sx(s.guard), [slot_of(o) for o in s.outputs],
+                                          s.text))
+                elif isinstance(s, Reinit):
                     reinits.append((name_of(s.target), to_sx(s.value)))
                 else:
                     assigns.append((slot_of(s.lhs.sym), to_sx(s.rhs)))
             assigns, reinits = _simultaneous(assigns, reinits, here, slot_sx)
-            branches.append(FlatBranch(to_sx(cond), to_text(cond), assigns, reinits))
+            branches.append(FlatBranch(to_sx(cond), to_text(cond), assigns, reinits, calls))
         part.whens.append(FlatWhen(branches, here))
     part.pre = [(slot_of(p), name_of(p.pre_of)) for p in draft.pres.values()]
     for s in draft.specials.values():

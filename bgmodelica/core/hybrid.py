@@ -132,6 +132,8 @@ def is_boolean(e: Any) -> bool:
     """Whether ``e`` is a Boolean-valued expression (relation, logic, Boolean variable,
     ``initial()``, ``sample()``)."""
     if isinstance(e, Leaf):
+        if isinstance(e.sym, Symbol) and e.sym.pre_of is not None:
+            return is_boolean(e.sym.pre_of.leaf)
         return isinstance(e.sym, Symbol) and (
             isinstance(e.sym.decl, Boolean) or getattr(e.sym.decl, "type_name", "") == "Boolean")
     if isinstance(e, Op):
@@ -293,6 +295,37 @@ def reinit(x: Any, value: Any) -> Reinit:
     return Reinit(sym, value)
 
 
+class RuntimeOutput(_Special):
+    """One scalar output of a :class:`RuntimeCall`: a hidden discrete slot the call writes."""
+
+    __slots__ = ("call",)
+
+    def __init__(self, name: str, boolean: bool = False) -> None:
+        super().__init__(name, Boolean() if boolean else Discrete(), None)
+        self.call: RuntimeCall | None = None
+
+
+@dataclass
+class RuntimeCall:
+    """A statement of a ``when`` body: a function evaluated on numbers when the branch fires.
+
+    ``function(values)`` takes the numeric values of ``args`` (scalar expressions of the
+    model, in order) and returns the values of ``outputs`` (a flat sequence of numbers); it
+    runs only where ``guard`` (a Boolean expression or True) holds, before the branch's
+    assignments, which may read the outputs. Calls of one branch run in order. ``text``
+    names the call (``file:line: name``) for messages."""
+
+    function: Any
+    args: list[Any]
+    guard: Any
+    outputs: list[RuntimeOutput]
+    text: str
+
+    def __post_init__(self) -> None:
+        for o in self.outputs:
+            o.call = self
+
+
 @dataclass
 class When:
     """``when c1 then ... elsewhen c2 then ... end when`` (see :func:`when`)."""
@@ -324,7 +357,7 @@ def _statements(stmts: Sequence[Any]) -> list[Any]:
     for s in stmts:
         if isinstance(s, (list, tuple)):
             out.extend(_statements(s))
-        elif isinstance(s, (Equation, Reinit)):
+        elif isinstance(s, (Equation, Reinit, RuntimeCall)):
             out.append(s)
         else:
             raise EquationError(f"a when() body holds 'd == value' assignments and reinit() "

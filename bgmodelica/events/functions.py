@@ -7,14 +7,14 @@ discrete variables, ``pre`` values, clocks, table coefficients).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
 
 from ..backends.casadi_dae import CasadiDAE
 from ..core.flatmodel import HybridPart
-from ..errors import EquationError
+from ..errors import EquationError, SimulationError
 
 
 @dataclass
@@ -40,6 +40,11 @@ class HybridFunctions:
     initial_branch: np.ndarray | None = None
     #: the algebraic residual, (z, [t, x, p]) -> alg (DAE models only)
     alg: ca.Function | None = None
+    #: (t, x, z, p) -> the guards and arguments of the functions run at events, stacked
+    calls: ca.Function | None = None
+    #: per branch: its runtime calls as (function, guard position, argument positions,
+    #: p indices of the outputs, text), in order
+    call_of: list[list[tuple]] = field(default_factory=list)
 
     @property
     def relations(self):
@@ -121,6 +126,7 @@ def build(dae: CasadiDAE) -> HybridFunctions:
     if hyb.initial >= 0 and conds:
         init_sym = p[nb + hyb.initial]
         out.initial_branch = np.array([bool(ca.depends_on(c, init_sym)) for c in conds])
+    _runtime_calls(out, hyb, t, x, z, p, nb)
     dae.cache["hybrid"] = out
     return out
 
@@ -139,6 +145,40 @@ def _size(r) -> float:
     """Largest magnitude of a residual (inf when not finite)."""
     r = np.asarray(r, dtype=float).ravel()
     return float(np.max(np.abs(r), initial=0.0)) if np.all(np.isfinite(r)) else np.inf
+
+
+def _runtime_calls(out: HybridFunctions, hyb: HybridPart, t, x, z, p, nb: int) -> None:
+    """The functions a fired branch runs on numbers (:class:`~bgmodelica.core.flatmodel.
+    FlatCall`): one CasADi function gives all their guards and arguments."""
+    exprs: list = []
+    for w in hyb.whens:
+        for b in w.branches:
+            entries = []
+            for c in b.calls:
+                g = len(exprs)
+                exprs += [c.guard, *c.args]
+                entries.append((c.function, g, np.arange(g + 1, g + 1 + len(c.args)),
+                                np.array([nb + s for s in c.outputs], dtype=int), c.text))
+            out.call_of.append(entries)
+    if exprs:
+        out.calls = ca.Function("runtime_args", [t, x, z, p],
+                                [ca.densify(ca.vertcat(*[ca.SX(e) for e in exprs]))])
+
+
+def run_calls(fn: HybridFunctions, t: float, x, z, p: np.ndarray, fired: list[int]) -> None:
+    """Run the functions of the ``fired`` branches on numbers, writing their outputs into
+    ``p`` (in order: each sees the outputs of those before it)."""
+    for b in fired:
+        for function, g, pos, slots, text in fn.call_of[b]:
+            vals = np.asarray(fn.calls(t, x, z, p), dtype=float).ravel()
+            if not vals[g]:
+                continue
+            try:
+                p[slots] = function(vals[pos])
+            except SimulationError:
+                raise
+            except Exception as err:  # noqa: BLE001 -- one line naming the call
+                raise SimulationError(f"{text} at t = {t:g} s: {err}", t) from None
 
 
 def _value_of(dae: CasadiDAE, name: str) -> tuple[ca.SX, bool]:

@@ -31,7 +31,7 @@ from ..backends.casadi_init import initialize
 from ..core.flatmodel import HybridPart
 from .crossings import CrossingMixin
 from .fast import Fast
-from .functions import HybridFunctions, build, solve_algebraic
+from .functions import HybridFunctions, build, run_calls, solve_algebraic
 from .integrators import SegmentMixin
 from .mixed import Cycle, EventError, MixedSystemMixin
 from .schedule import is_sample_instant, next_sample, table_coefficients
@@ -337,6 +337,10 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin, MixedSystemMixin, Segm
                         fired.append(b)
                         break
             self.cond_pre = cond
+            if fn.calls is not None and any(fn.call_of[b] for b in fired):
+                run_calls(fn, t, x, z, self.p, fired)
+                out = self._step(t, x, z)
+                assign, reinit, pre_src = out[3], out[4], out[5]
             new_x, fixed = np.array(x, dtype=float), []
             for b in fired:
                 for pidx, pos in fn.assign_of[b]:

@@ -239,6 +239,10 @@ def build_hybrid(dae: CasadiDAE, flat, by_name: dict, z_of, pfull_of) -> HybridS
     (MX, fast_newton) or None without them; ``pfull_of(p, u, d)``: the native ``p``."""
     fn = build(dae)
     hyb = dae.hybrid
+    if fn.calls is not None:
+        text = next(c[4] for branch in fn.call_of for c in branch)
+        raise FmuSpecError(f"{text}: a function run on numbers at events cannot be exported "
+                           "to an FMU")
     nb = dae.n_base
     nx, nu, np_, nd = dae.x.numel(), len(dae.inputs), len(dae.parameters), len(dae.discretes)
     t = ca.MX.sym("t")

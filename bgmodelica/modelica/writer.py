@@ -11,7 +11,16 @@ from typing import Any
 
 from ..core.component import Connection, Element
 from ..core.expr import Equation, Leaf, Op
-from ..core.hybrid import _INITIAL, _TERMINAL, IfEquation, Reinit, SampleClock, TimeTable, When
+from ..core.hybrid import (
+    _INITIAL,
+    _TERMINAL,
+    IfEquation,
+    Reinit,
+    RuntimeCall,
+    SampleClock,
+    TimeTable,
+    When,
+)
 from ..core.variables import TIME, Symbol
 from .errors import ModelicaExportError
 
@@ -234,6 +243,9 @@ class ExpressionWriter:
                 head = "when" if k == 0 else "elsewhen"
                 out.append(f"{indent}{head} {self.expr(cond, base, 'a when-condition')} then")
                 for st in stmts:
+                    if isinstance(st, RuntimeCall):
+                        raise ModelicaExportError(f"{st.text}: a function call run on numbers "
+                                                  "at events cannot be written back")
                     if isinstance(st, Reinit):
                         out.append(f"{indent}  reinit({self.leaf(st.target, base, 'reinit')}, "
                                    f"{self.expr(st.value, base, 'reinit')});")

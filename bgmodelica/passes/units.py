@@ -41,7 +41,7 @@ from ..core.array_marks import has_one_unit
 from ..core.arrays import ArrayEquation, ArrayExpr, array_text
 from ..core.expr import Equation, Expr, Leaf, Number, Op, to_text
 from ..core.flatmodel import EquationSources, FlatModel
-from ..core.hybrid import Reinit, SampleClock
+from ..core.hybrid import Reinit, RuntimeCall, SampleClock
 from ..core.units import SECOND, UnitParseError, parse
 from ..core.variables import (
     Boolean,
@@ -229,6 +229,8 @@ class _Checker:
                 self._guard(lambda h=here, c=cond: f"{h}: when {to_text(c)}",
                             lambda c=cond: self.infer(c))
                 for s in stmts:
+                    if isinstance(s, RuntimeCall):
+                        continue            # numbers at events: no units to check
                     if isinstance(s, Reinit):
                         self._guard(
                             lambda h=here, s=s: f"{h}: reinit({s.target.name}, "

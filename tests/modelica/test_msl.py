@@ -137,3 +137,46 @@ def test_a_file_of_the_package_folder_with_its_experiment(tmp_path, monkeypatch,
     rows = out.read_text().splitlines()[1:]
     assert float(rows[-1].split(",")[0]) == pytest.approx(1.0)
     assert len(rows) >= 1001             # the experiment's Interval = 1 ms (default: 501 rows)
+
+
+def test_tables_and_radio_buttons_of_interaction1(msl):
+    """Blocks.Examples.Interaction1: TimeTable's coefficients come from a function with a
+    while loop over time, run at its events; the radio buttons reset each other."""
+    r = bg.simulate(load_class("Modelica.Blocks.Examples.Interaction1"), stop_time=10,
+                    interval=0.01)
+
+    def at(name: str, t: float) -> float:
+        return float(r[name][abs(r.time - t).argmin()])
+
+    # table [0, 0; 1, 2.1; 2, 4.2; 3, 6.3; 4, 4.2; 6, 2.1; 6, 2.1], linear
+    for t, y in ((0.5, 1.05), (2.5, 5.25), (3.5, 5.25), (5.0, 3.15), (8.0, 2.1)):
+        assert abs(at("timeTable.y", t) - y) < 1e-9
+    # integer table held: 2 on [1, 2), 6 on [3, 4), 2 after 6
+    assert (at("integerTable.y", 1.5), at("integerTable.y", 3.5), at("integerTable.y", 8.5)) \
+        == (2, 6, 2)
+    # start pressed at 1 and 3, stop at 2 and 4; each resets the other
+    on = [(at("start.on", t), at("stop.on", t)) for t in (0.5, 1.5, 2.5, 3.5, 4.5)]
+    assert on == [(0, 0), (1, 0), (0, 1), (1, 0), (0, 1)]
+
+
+def test_fft_of_a_sampled_current_at_the_end(msl, tmp_path, monkeypatch):
+    """Blocks.Examples.Rectifier6pulseFFT: a buffer sampled in a when-clause, its FFT at
+    terminal() and the result file written; the signals match their reference."""
+    monkeypatch.chdir(tmp_path)
+    full = "Modelica.Blocks.Examples.Rectifier6pulseFFT"
+    model = load_class(full)
+    result = bg.simulate(model, **experiment_of(model))
+    from scipy.io import loadmat
+
+    fft = loadmat(tmp_path / "rectifier6pulseFFTresult.mat")["FFT"][1::3]
+    top = sorted(fft[np.argsort(-fft[:, 1])[:7], 0])
+    # the fundamental (50 Hz) and the harmonics 5, 7, 11, 13, 17, 19 of a 6-pulse bridge
+    assert top == [50, 250, 350, 550, 650, 850, 950]
+    ref = REFS / full
+    if not (ref / "ref.csv.gz").is_file():
+        pytest.skip(f"no reference for {full} in {REFS}")
+    csv = tmp_path / "result.csv"
+    result.to_csv(csv)
+    done = subprocess.run([sys.executable, str(REFS / "check_msl.py"), str(csv), str(ref)],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stdout + done.stderr

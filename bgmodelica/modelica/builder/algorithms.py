@@ -15,7 +15,7 @@ from typing import Any
 from ...core.expr import Expr
 from .. import ast as A
 from .arith import _if_else
-from .base import Ctx, NotConstant, fail, numeric_value
+from .base import Ctx, NotConstant, fail, numeric_value, varying
 from .types import check_condition
 
 #: statements run per call before a loop is taken for endless
@@ -83,7 +83,7 @@ def _run(stmts: tuple, ctx: Ctx, state: _State) -> None:
             while True:
                 c = _known(evaluate(st.condition, ctx), ctx)
                 if _symbolic(c):
-                    raise fail(ctx.lex, st, "while-loop condition depends on time-varying "
+                    raise varying(ctx.lex, st, "while-loop condition depends on time-varying "
                                "values (not supported)")
                 if not c:
                     break
@@ -123,6 +123,8 @@ def _if(st: A.StmtIf, ctx: Ctx, state: _State) -> None:
                 return
             continue
         # a symbolic condition: both sides, merged
+        from . import runtime
+
         rest = A.StmtIf(st.branches[k + 1:], st.otherwise, st.pos) if st.branches[k + 1:] \
             else None
         then_vals = {n: _lists(v) for n, v in ctx.loops.items()}
@@ -131,25 +133,27 @@ def _if(st: A.StmtIf, ctx: Ctx, state: _State) -> None:
         then_done = else_done = False
         state.branching += 1
         try:
-            _run(body, Ctx(ctx.env, ctx.lex, then_vals, False), state)
+            with runtime.condition(c, ctx):
+                _run(body, Ctx(ctx.env, ctx.lex, then_vals, False), state)
         except _Return:
             then_done = True
         except _Break:
-            raise fail(ctx.lex, st, "break under a time-varying condition (not supported)") \
+            raise varying(ctx.lex, st, "break under a time-varying condition (not supported)") \
                 from None
         finally:
             state.branching -= 1
         g_then, state.guard = state.guard, g0
         state.branching += 1
         try:
-            if rest is not None:
-                _if(rest, Ctx(ctx.env, ctx.lex, else_vals, False), state)
-            else:
-                _run(st.otherwise, Ctx(ctx.env, ctx.lex, else_vals, False), state)
+            with runtime.condition(runtime.negated(c), ctx):
+                if rest is not None:
+                    _if(rest, Ctx(ctx.env, ctx.lex, else_vals, False), state)
+                else:
+                    _run(st.otherwise, Ctx(ctx.env, ctx.lex, else_vals, False), state)
         except _Return:
             else_done = True
         except _Break:
-            raise fail(ctx.lex, st, "break under a time-varying condition (not supported)") \
+            raise varying(ctx.lex, st, "break under a time-varying condition (not supported)") \
                 from None
         finally:
             state.branching -= 1
@@ -159,7 +163,7 @@ def _if(st: A.StmtIf, ctx: Ctx, state: _State) -> None:
             if a is b:
                 ctx.loops[name] = a
             elif a is None or b is None:
-                raise fail(ctx.lex, st, f"{name} is assigned in one branch only of an if "
+                raise varying(ctx.lex, st, f"{name} is assigned in one branch only of an if "
                            "on a time-varying condition")
             else:
                 ctx.loops[name] = _merge(c, a, b, ctx, st)
@@ -192,7 +196,7 @@ def _merge(c: Any, a: Any, b: Any, ctx: Ctx, node: Any) -> Any:
     if isinstance(a, str) or isinstance(b, str):
         if a == b:
             return a
-        raise fail(ctx.lex, node, "a String depends on a time-varying condition")
+        raise varying(ctx.lex, node, "a String depends on a time-varying condition")
     if _same(a, b):
         return a
     return _if_else(c, a, b, ctx, node)
@@ -271,7 +275,7 @@ def _store(ref: Any, value: Any, ctx: Ctx, node: Any) -> None:
             continue
         v = _known(evaluate(s, num), ctx)
         if isinstance(v, list) and _symbolic(v):
-            raise fail(ctx.lex, node, f"subscript of {name} depends on time-varying values")
+            raise varying(ctx.lex, node, f"subscript of {name} depends on time-varying values")
         idx.append(v)
     ctx.loops[name] = _set(cur, idx, value, ctx, node, name)
 

@@ -83,6 +83,18 @@ def fail(lex: S.ClassScope | None, node: Any, message: str) -> ModelicaError:
     return ModelicaError(f"{_where(lex, pos)}: {message}")
 
 
+class TimeVarying(ModelicaError):
+    """A construct of a function body that needs values known when the model is built got
+    time-varying ones (a while-loop condition, an external function's arguments...); inside
+    a when-clause the call then runs on numbers at events (:mod:`.runtime`)."""
+
+
+def varying(lex: S.ClassScope | None, node: Any, message: str) -> TimeVarying:
+    """:class:`TimeVarying` at ``node``'s position (as :func:`fail`)."""
+    err = fail(lex, node, message)
+    return TimeVarying(str(err))
+
+
 class Ctx:
     """Evaluation context: the instance environment (or None for static values), the lexical
     class scope, loop variables, and whether values must be known numbers."""

@@ -15,7 +15,7 @@ from ...core.expr import RELATIONS, Op
 from .. import ast as A
 from .. import scope as S
 from .algorithms import _Break, _lists, _Return, _run, _State, _symbolic
-from .base import Ctx, NotConstant, fail, numeric_value
+from .base import Ctx, NotConstant, TimeVarying, fail, numeric_value, varying
 
 
 class FunctionDef:
@@ -99,7 +99,22 @@ def call_function(scope: S.ClassScope, node: A.Call, ctx: Ctx) -> Any:
 
     args = [evaluate(a, ctx) for a in node.args]
     kwargs = {k: evaluate(v, ctx) for k, v in node.kwargs.items()}
-    return apply_function(scope, args, kwargs, ctx, node)
+    return _apply_or_defer(scope, args, kwargs, ctx, node, False)
+
+
+def _apply_or_defer(scope: S.ClassScope, args: list, kwargs: dict, ctx: Ctx, node: Any,
+                    all_outputs: bool) -> Any:
+    """:func:`apply_function`; in a when-clause of a model, a call whose body cannot take
+    its time-varying arguments symbolically runs on numbers at events instead
+    (:mod:`.runtime`)."""
+    from . import runtime
+
+    try:
+        return apply_function(scope, args, kwargs, ctx, node, all_outputs)
+    except (TimeVarying, NotConstant):
+        if not runtime.active(ctx) or not _symbolic([*args, *kwargs.values()]):
+            raise
+    return runtime.deferred(scope, args, kwargs, ctx, node, all_outputs)
 
 
 def apply_function(scope: S.ClassScope, args: list, kwargs: dict, ctx: Ctx, node: Any,
@@ -250,7 +265,7 @@ def call_outputs(call: A.Call, ctx: Ctx) -> tuple:
                    "needs a Modelica function with several outputs")
     args = [evaluate(a, ctx) for a in call.args]
     kwargs = {k: evaluate(v, ctx) for k, v in call.kwargs.items()}
-    return apply_function(scope, args, kwargs, ctx, call, all_outputs=True)
+    return _apply_or_defer(scope, args, kwargs, ctx, call, True)
 
 
 def _c_value(v: Any) -> Any:
@@ -306,15 +321,22 @@ def _external(fn: FunctionDef, local: dict, ctx: Ctx, node: Any) -> None:
         raise
     except Exception as err:  # noqa: BLE001 -- one line naming the function
         if _symbolic(args):
-            raise fail(ctx.lex, node, f"unsupported Modelica construct: external function "
-                       f"{cname} (called by {fn.name}) on time-varying arguments (it runs on "
-                       "values known when the model is built)") from None
+            raise varying(ctx.lex, node, f"unsupported Modelica construct: external function "
+                          f"{cname} (called by {fn.name}) on time-varying arguments (it runs on "
+                          "values known when the model is built)") from None
         raise fail(ctx.lex, node, f"{fn.name}(): {err}") from None
     if len(out_names) == 1:
-        local[out_names[0]] = got
+        local[out_names[0]] = _from_c(got)
     elif len(out_names) > 1:
         if not isinstance(got, tuple) or len(got) != len(out_names):
             raise fail(lex, ext, f"external {cname} returned {type(got).__name__}, expected "
                        f"{len(out_names)} outputs")
         for n, v in zip(out_names, got, strict=True):
-            local[n] = v
+            local[n] = _from_c(v)
+
+
+def _from_c(v: Any) -> Any:
+    """A numeric array result of a native implementation as the nested lists arrays are."""
+    import numpy as np
+
+    return v.tolist() if isinstance(v, np.ndarray) and v.dtype != object else v

@@ -163,6 +163,8 @@ def _discrete_by_when(view: ClassView) -> None:
             names.update(i.parts[0][0] for i in eq.lhs.items if isinstance(i, A.Ref))
         elif isinstance(eq, A.Assign) and isinstance(eq.target, A.Ref):
             names.add(eq.target.parts[0][0])
+        elif isinstance(eq, A.Assign) and isinstance(eq.target, A.TupleExpr):
+            names.update(i.parts[0][0] for i in eq.target.items if isinstance(i, A.Ref))
         elif isinstance(eq, (A.EqIf, A.StmtIf, A.EqWhen, A.StmtWhen)):
             for _, body in eq.branches:
                 for sub in body:

@@ -165,6 +165,13 @@ def _size_from_binding(info: ElemInfo, env: Env | None, k: int) -> int:
     if m is None or not m.has_binding:
         raise fail(info.lex, info.comp, f"{info.comp.name}: an array size ':' needs a binding "
                    "to take its size from")
+    lit = m.binding
+    for _ in range(k):
+        lit = lit.items[0] if isinstance(lit, A.ArrayLit) and lit.items else None
+    if isinstance(lit, A.ArrayLit):
+        # an array constructor's size needs no values (``reset={other.on}`` may name a
+        # sibling built later)
+        return len(lit.items)
     v = m.value(True)
     for _ in range(k):
         v = v[0] if isinstance(v, list) and v else v

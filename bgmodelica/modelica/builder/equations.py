@@ -402,34 +402,14 @@ def _residuals(ifeq: Any, ctx: Ctx, node: Any) -> list:
 
 
 def _eval_when(eq: A.EqWhen, ctx: Ctx) -> Any:
+    from . import runtime
+
     result = None
     for cond, body in eq.branches:
         c = evaluate(cond, ctx)
-        stmts: list = []
-        for st in body:
-            if isinstance(st, A.EqSimple):
-                a = evaluate(st.lhs, ctx)
-                b = evaluate(st.rhs, ctx)
-                _equation(a, b, ctx, st, stmts)
-            elif isinstance(st, A.EqCall) and st.call.func.dotted == "reinit":
-                if len(st.call.args) != 2:
-                    raise fail(ctx.lex, st, "reinit(x, value) takes two arguments")
-                x = evaluate(st.call.args[0], ctx)
-                v = evaluate(st.call.args[1], ctx)
-                xs, vs = (x, v) if isinstance(x, list) else ([x], [v])
-                for xi, vi in zip(xs, vs if isinstance(vs, list) else [vs] * len(xs),
-                                  strict=True):
-                    try:
-                        stmts.append(H.reinit(xi, vi))
-                    except ModelError as err:
-                        raise fail(ctx.lex, st, str(err)) from None
-            elif isinstance(st, A.EqCall) and st.call.func.dotted in ("assert",):
-                continue
-            elif isinstance(st, A.EqCall) and st.call.func.dotted == "terminate":
-                raise fail(ctx.lex, st, "unsupported Modelica construct: terminate()")
-            else:
-                raise fail(ctx.lex, st, "unsupported Modelica construct in a when-equation "
-                           "(supported: 'v = expression' and reinit(x, value))")
+        with runtime.discrete_context() as calls:
+            stmts = _when_body(body, ctx)
+        stmts[:0] = calls
         try:
             if result is None:
                 result = H.when(c, *stmts)
@@ -438,6 +418,36 @@ def _eval_when(eq: A.EqWhen, ctx: Ctx) -> Any:
         except ModelError as err:
             raise fail(ctx.lex, eq, str(err)) from None
     return result
+
+
+def _when_body(body: Any, ctx: Ctx) -> list:
+    """The statements of one branch of a when-equation."""
+    stmts: list = []
+    for st in body:
+        if isinstance(st, A.EqSimple):
+            a = evaluate(st.lhs, ctx)
+            b = evaluate(st.rhs, ctx)
+            _equation(a, b, ctx, st, stmts)
+        elif isinstance(st, A.EqCall) and st.call.func.dotted == "reinit":
+            if len(st.call.args) != 2:
+                raise fail(ctx.lex, st, "reinit(x, value) takes two arguments")
+            x = evaluate(st.call.args[0], ctx)
+            v = evaluate(st.call.args[1], ctx)
+            xs, vs = (x, v) if isinstance(x, list) else ([x], [v])
+            for xi, vi in zip(xs, vs if isinstance(vs, list) else [vs] * len(xs),
+                              strict=True):
+                try:
+                    stmts.append(H.reinit(xi, vi))
+                except ModelError as err:
+                    raise fail(ctx.lex, st, str(err)) from None
+        elif isinstance(st, A.EqCall) and st.call.func.dotted in ("assert",):
+            continue
+        elif isinstance(st, A.EqCall) and st.call.func.dotted == "terminate":
+            raise fail(ctx.lex, st, "unsupported Modelica construct: terminate()")
+        else:
+            raise fail(ctx.lex, st, "unsupported Modelica construct in a when-equation "
+                       "(supported: 'v = expression' and reinit(x, value))")
+    return stmts
 
 
 def _declaration_equations(inst: Element, bindings: list, connector: bool,

@@ -16,6 +16,7 @@ from .. import scope as S
 from .arith import _flatten, _num_or_expr, _shape, _sum
 from .base import Ctx, NotConstant, check_array_size, fail, numeric_value
 from .evaluate import _comprehension, evaluate
+from .text import fn_string
 from .types import check_der_argument
 
 
@@ -323,19 +324,34 @@ def _fn_size(node: A.Call, ctx: Ctx) -> Any:
         try:
             first = evaluate(node.args[0], ctx)
         except NotConstant:
-            first = evaluate(node.args[0], Ctx(ctx.env, ctx.lex, ctx.loops, False))
+            shape = _declared_shape(node.args[0], ctx)
+            first = evaluate(node.args[0], Ctx(ctx.env, ctx.lex, ctx.loops, False)) \
+                if shape is None else shape
         rest = _args(A.Call(node.func, node.args[1:], node.kwargs, node.pos), ctx, (0, 1),
                      "size")
         args = [first, *rest]
     else:
         args = _args(node, ctx, (1, 2), "size")
-    shape = _shape(args[0])
+    shape = args[0] if isinstance(args[0], tuple) else _shape(args[0])
     if len(args) == 1:
         return list(shape)
     k = numeric_value(args[1], ctx.lex, node)
     if not 1 <= k <= len(shape):
         raise fail(ctx.lex, node, f"size(a, {k}): a has {len(shape)} dimension(s)")
     return shape[int(k) - 1]
+
+
+def _declared_shape(arg: Any, ctx: Ctx) -> tuple | None:
+    """The declared dimensions of the variable ``arg`` names, when its instance is not built
+    yet (a size the model's other declarations take from it); else None."""
+    from .env import _dims
+
+    env = ctx.env
+    if env is None or env.inst is not None or not isinstance(arg, A.Ref) \
+            or len(arg.parts) != 1 or arg.parts[0][1]:
+        return None
+    info = env.view.elements.get(arg.parts[0][0])
+    return None if info is None else _dims(info, env)
 
 
 def _sizes(node: A.Call, ctx: Ctx, name: str, first: int = 0) -> tuple[list, list[int]]:
@@ -460,7 +476,7 @@ _FUNCTIONS: dict[str, Any] = {
     "cardinality": _fn_unsupported("cardinality", "cardinality()"),
     "inStream": _fn_unsupported("inStream", "stream connectors (inStream)"),
     "actualStream": _fn_unsupported("actualStream", "stream connectors (actualStream)"),
-    "String": _fn_unsupported("String", "String() conversions"),
+    "String": fn_string,
     "connect": _fn_statement("connect"), "reinit": _fn_statement("reinit"),
     "assert": _fn_statement("assert"), "terminate": _fn_statement("terminate"),
 }

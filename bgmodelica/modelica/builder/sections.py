@@ -39,7 +39,7 @@ def section_equations(stmts: A.Statements, ctx: Ctx, out: list, initial: bool) -
         pass
     in_when: set[str] = set()
     for branches in state.whens:
-        for _, assigned in branches:
+        for _, assigned, _ in branches:
             in_when |= set(assigned)
     for n in names:
         if n in in_when:
@@ -81,11 +81,11 @@ def _when_of(branches: list, leaves: dict, ctx: Ctx, node: Any) -> Any:
     from .equations import _equation
 
     union: list[str] = []
-    for _, assigned in branches:
+    for _, assigned, _ in branches:
         union += [n for n in assigned if n not in union]
     result = None
-    for cond, assigned in branches:
-        eqs: list = []
+    for cond, assigned, calls in branches:
+        eqs: list = list(calls)
         for n in union:
             _equation(leaves[n], assigned.get(n, _pre(leaves[n])), ctx, node, eqs)
         result = H.when(cond, *eqs) if result is None else result.elsewhen(cond, *eqs)
@@ -135,6 +135,7 @@ def _targets(stmts: Any) -> list[str]:
 def _when_statement(st: A.StmtWhen, ctx: Ctx, state: _State) -> None:
     """A when-statement of a model's algorithm: each branch run from the ``pre`` values of
     what it assigns; collected for :func:`section_equations`."""
+    from . import runtime
     from .evaluate import evaluate
 
     branches = []
@@ -144,6 +145,7 @@ def _when_statement(st: A.StmtWhen, ctx: Ctx, state: _State) -> None:
         local = dict(ctx.loops)
         for n in names:
             local[n] = _pre(state.leaves[n]) if n in state.leaves else None
-        _run(body, Ctx(ctx.env, ctx.lex, local, False), state)
-        branches.append((c, {n: local[n] for n in names}))
+        with runtime.discrete_context() as calls:
+            _run(body, Ctx(ctx.env, ctx.lex, local, False), state)
+        branches.append((c, {n: local[n] for n in names}, calls))
     state.whens.append(branches)
