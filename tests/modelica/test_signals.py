@@ -210,3 +210,32 @@ end Loop;
     with pytest.raises(ModelicaError, match=r"<string>:6:\d+: cannot evaluate when the model "
                                             r"is built: k is a variable"):
         bg.compile(load_modelica_text(text, "Loop"))
+
+
+def test_later_record_read_with_its_own_modifiers():
+    """``t(R1 = data.v)`` with ``data`` declared later: ``data.v``'s binding reads
+    ``data``'s modifier ``C1`` (the transformer data of a 12-pulse rectifier), not the
+    record's default, and ``t.VG`` is the value its class's extends clause sets."""
+    model = load_modelica_text("""
+model Top
+  partial model Base
+    constant String VG = "Yy00";
+    parameter Real R1 = 0;
+    Real x;
+  equation
+    x = R1;
+  end Base;
+  model Delta
+    extends Base(final VG = "Dd00");
+  end Delta;
+  record Data
+    parameter String C1;
+    parameter Real v = if C1 == "Dd00" then 1 else 2;
+  end Data;
+  Delta t(R1 = data.v);
+  parameter Data data(C1 = t.VG);
+  Real y = data.v;
+end Top;
+""", "Top")
+    r = bg.simulate(model, stop_time=0.1, interval=0.1)
+    assert r["t.x"][-1] == 1.0 and r["y"][-1] == 1.0

@@ -219,6 +219,10 @@ def sibling_parameter(env: Env, name: str, rest: tuple) -> tuple | None:
         tref = type_ref(env.view.elements[name])
         if tref.kind != "class" or tref.scope is None:
             return None
-        return (static_env(tref.scope).numeric(pname),)
+        if m is None or not m.sub:
+            return (static_env(tref.scope).numeric(pname),)
+        # its class's binding, read with the sibling's other modifiers (``data(C1=...)``
+        # for ``v = if C1 == "D" then 1 else 2``)
+        return (Env(class_view(tref.scope), m.sub, env, f"{env.path}.{name}").numeric(pname),)
     except (NotConstant, KeyError):
         return None
