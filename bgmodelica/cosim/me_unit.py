@@ -20,6 +20,7 @@ from __future__ import annotations
 import ctypes
 import functools
 import math
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -78,6 +79,13 @@ class ModelExchangeUnit(_Unit):
                     self._event(lambda: self._in_disc.set(self.fmu, d))
                 self._disc_set = d.copy()
 
+    def set_text(self, values: Mapping[str, Any]) -> None:
+        """String/Binary inputs are discrete: set in event mode once the run has started."""
+        if values and getattr(self, "_running", False):
+            self._event(lambda: self.set_values(values))
+        else:
+            self.set_values(values)
+
     def _set_continuous_inputs(self, values: np.ndarray) -> None:
         if len(self._cont):
             self._in_cont.set(self.fmu, np.asarray(values, dtype=float)[self._cont])
@@ -104,6 +112,7 @@ class ModelExchangeUnit(_Unit):
             self.x = np.zeros(self.nx)
         self._iterate()                       # the initial event iteration (event mode)
         self._get_states()
+        self._running = True
 
     # FMU calls ----------------------------------------------------------------------------------
     def _ptr(self, arr: np.ndarray) -> Any:

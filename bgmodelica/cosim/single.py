@@ -3,8 +3,9 @@
 
 The result has the same conventions as :func:`bgmodelica.simulate`: a ``time`` column and one
 column per variable under the FMU's own names (array elements as ``x[1]``...), Booleans as
-0/1. Inputs come from a CSV (``time`` first, one column per input; linear between rows, a
-repeated time is a jump, the last row held) or a mapping ``{name: (times, values)}``; inputs
+0/1; String and Binary variables are in ``result.text`` (``str``, ``bytes``). Inputs come
+from a CSV (``time`` first, one column per input; linear between rows, a repeated time is a
+jump, the last row held) or a mapping ``{name: (times, values)}``; inputs
 without data keep their start values.
 """
 
@@ -86,8 +87,7 @@ def simulate_fmu(fmu: str | Path, *, stop_time: float | None = None,
                     me_atol=atol)
     result = master.simulate(t1, h, start_time=t0,
                              parameters={ELEMENT: dict(parameters or {})},
-                             record=[f"{ELEMENT}.{n}" for n in extra if info.variables[n].type
-                                     not in ("String", "Binary")],
+                             record=[f"{ELEMENT}.{n}" for n in extra],
                              inputs={f"{ELEMENT}.{k}": v for k, v in table.items()},
                              tolerance=rtol)
     prefix = ELEMENT + "."
@@ -101,4 +101,5 @@ def simulate_fmu(fmu: str | Path, *, stop_time: float | None = None,
         meta["events"] = meta["events"].get(ELEMENT, [])
     return Result(result.time, result.values, columns,
                   parameters={k[len(prefix):]: v for k, v in result.parameters.items()},
-                  units={k[len(prefix):]: v for k, v in result.units.items()}, meta=meta)
+                  units={k[len(prefix):]: v for k, v in result.units.items()}, meta=meta,
+                  text={k[len(prefix):]: v for k, v in result.text.items()})

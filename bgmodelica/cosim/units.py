@@ -31,7 +31,7 @@ import numpy as np
 from .archive import _one_line
 from .errors import CosimStepError, SetupError
 from .fmu import _EXTRACTED, FmuInfo
-from .values import PortAccess, set_by_name, to_fmi
+from .values import PortAccess, get_text, set_by_name, to_fmi
 
 # FMI 2.0 log messages are variadic; fmpy formats them with a native proxy that forwards to
 # ONE process-wide Python logger (a C global set by ``addLoggerProxy``). That logger must
@@ -196,6 +196,15 @@ class _Unit:
                 raise SetupError(f"element {self.name!r}: {err}") from None
             self._readers[key] = reader
         return self._call(reader.get, self.fmu, np.zeros(len(names)))
+
+    def get_text(self, names: list[str]) -> list[Any]:
+        """Values of String (``str``) and Binary (``bytes``) variables by name."""
+        variables = [self.info.variable(n, self.name) for n in names]
+        return self._call(get_text, self.fmu, self.info.fmi_version, variables)
+
+    def set_text(self, values: Mapping[str, Any]) -> None:
+        """Set String/Binary inputs during the run (a Model Exchange unit at an event)."""
+        self.set_values(values)
 
     def set_values(self, values: Mapping[str, Any]) -> None:
         """Set variables of any type by name (parameters, start values, tunable parameters;
