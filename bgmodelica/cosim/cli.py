@@ -110,7 +110,7 @@ def cmd_cosim(args: argparse.Namespace) -> int:
     safe = re.sub(r"[^A-Za-z0-9_.-]", "_", system.name).lstrip(".") or "system"
     out = out_arg or _writable(f"{safe}_cosim.csv", "output file")   # in the working folder
     assert out is not None
-    master = Master(system, interface=args.interface or "cs")
+    master = Master(system, interface=args.interface or "cs", me_euler_step=args.euler_step)
     order = args.order or system.master.get("order", "jacobi")
     extrapolation = args.extrapolation
     if extrapolation is None:
@@ -164,7 +164,7 @@ def _run_fmu(args: argparse.Namespace, fmu: str, interval: float | None, suffix:
     res = simulate_fmu(fmu, stop_time=args.stop_time, interval=interval,
                        parameters=sets, inputs=args.input, interface=args.interface or "auto",
                        rtol=getattr(args, "rtol", 1e-8), atol=getattr(args, "atol", 1e-10),
-                       record=args.record)
+                       record=args.record, euler_step=args.euler_step)
     names = getattr(args, "plot_vars", None)
     missing = [n for n in names or () if n not in res.names]
     if missing:
@@ -269,6 +269,9 @@ def register(sub: Any, model_args: Any = None) -> None:
                      help="override a parameter of an element (one FMU: NAME=VALUE)")
     cos.add_argument("--record", nargs="+", metavar="ELEMENT.VAR",
                      help="record more variables (locals, states; one FMU: VAR)")
+    cos.add_argument("--euler-step", type=float, default=None, metavar="H",
+                     help="Model Exchange units: forward Euler at this fixed step (the FMI "
+                          "example importer) instead of Radau")
     cos.add_argument("--input", metavar="CSV",
                      help="one FMU: input signals, a 'time' column then one per input")
     cos.add_argument("-o", "--output", help="CSV file (default <system>_cosim.csv, one FMU: "
@@ -295,6 +298,9 @@ def register(sub: Any, model_args: Any = None) -> None:
     one.add_argument("--rtol", type=float, default=1e-8,
                      help="Model Exchange rtol, and the FMU's experiment tolerance")
     one.add_argument("--atol", type=float, default=1e-10, help="Model Exchange atol")
+    one.add_argument("--euler-step", type=float, default=None, metavar="H",
+                     help="Model Exchange: forward Euler at this fixed step (the FMI example "
+                          "importer) instead of Radau")
     one.add_argument("--record", nargs="+", metavar="VAR",
                      help="variables to record besides the outputs (default: the states)")
     one.add_argument("-o", "--output", help="CSV file (default <model>.csv)")

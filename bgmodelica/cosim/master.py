@@ -86,12 +86,14 @@ class Master:
     ``interface``: ``"cs"`` (default), ``"me"``, ``"auto"`` (the SSD ``implementation``
     attribute, else CS when available) or a dict element -> interface.
     ``allow_unconnected``: keep unconnected inputs at their start values instead of raising.
-    ``me_rtol``/``me_atol``: tolerances of the Model Exchange integrator.
+    ``me_rtol``/``me_atol``: tolerances of the Model Exchange integrator; ``me_euler_step``:
+    forward Euler at this fixed step instead (see :mod:`.me_unit`).
     """
 
     def __init__(self, system: SystemStructure | str | Path, *,
                  interface: str | Mapping[str, str] = "cs", allow_unconnected: bool = False,
-                 me_rtol: float = 1e-8, me_atol: float = 1e-10) -> None:
+                 me_rtol: float = 1e-8, me_atol: float = 1e-10,
+                 me_euler_step: float | None = None) -> None:
         if not isinstance(system, SystemStructure):
             system = read_ssp(system)
         self.system = system
@@ -113,7 +115,9 @@ class Master:
                 raise InvalidExperimentError(f"{name} must be finite and > 0, got {tol!r}")
         self.interfaces = {c.name: self._interface(c.name, c.implementation, interface)
                            for c in system.elements}
-        self.me_rtol, self.me_atol = me_rtol, me_atol
+        if me_euler_step is not None and not _finite(me_euler_step, "me_euler_step") > 0:
+            raise InvalidExperimentError(f"me_euler_step must be > 0, got {me_euler_step!r}")
+        self.me_rtol, self.me_atol, self.me_euler_step = me_rtol, me_atol, me_euler_step
 
     def _interface(self, name: str, implementation: str, wanted: Any) -> str:
         info = self.infos[name]
@@ -245,7 +249,8 @@ class Master:
             for comp in system.elements:
                 n = comp.name
                 unit = make_unit(n, self.infos[n], self.interfaces[n], plan.inputs[n],
-                                 plan.outputs[n], rtol=self.me_rtol, atol=self.me_atol)
+                                 plan.outputs[n], rtol=self.me_rtol, atol=self.me_atol,
+                                 euler_step=self.me_euler_step)
                 units[n] = unit
                 pset = {k: v for k, v in params[n].items()
                         if self.infos[n].variables[k].set_by_name}

@@ -410,12 +410,15 @@ class CoSimUnit(_Unit):
 
 
 def make_unit(name: str, info: FmuInfo, interface: str, input_names: list[str],
-              output_names: list[str], *, rtol: float = 1e-8, atol: float = 1e-10) -> _Unit:
-    """A :class:`CoSimUnit` (``interface="cs"``) or :class:`ModelExchangeUnit` (``"me"``)."""
+              output_names: list[str], *, rtol: float = 1e-8, atol: float = 1e-10,
+              euler_step: float | None = None) -> _Unit:
+    """A :class:`CoSimUnit` (``interface="cs"``) or :class:`ModelExchangeUnit` (``"me"``;
+    ``euler_step``: forward Euler at that step instead of Radau)."""
     if interface == "cs":
         return CoSimUnit(name, info, input_names, output_names)
     if interface == "me":
         from .me_unit import ModelExchangeUnit
 
-        return ModelExchangeUnit(name, info, input_names, output_names, rtol=rtol, atol=atol)
+        return ModelExchangeUnit(name, info, input_names, output_names, rtol=rtol, atol=atol,
+                                 euler_step=euler_step)
     raise SetupError(f"element {name!r}: interface must be 'cs' or 'me', not {interface!r}")

@@ -269,3 +269,25 @@ def test_single_fmu_through_the_cosim_command(c_fmus, tmp_path, capsys):
                        record=["label", "x"])
     assert list(res["label"]) == ["left 3", "left 3", "left 2", "left 2"]
     assert list(res["code"]) == [b"\x03\xa5", b"\x03\xa5", b"\x02\xa5", b"\x02\xa5"]
+
+
+def test_model_exchange_with_forward_euler(c_fmus, tmp_path, capsys):
+    """``euler_step``: Model Exchange by forward Euler at a fixed step, x_{k+1} = (I + hA) x_k
+    exactly; the time events of Countdown still fall on their instants."""
+    h = 0.01
+    res = simulate_fmu(c_fmus["StateSpace"], stop_time=1.0, interval=0.1, interface="me",
+                       euler_step=h)
+    x, step = X0.copy(), np.eye(3) + h * A
+    for k in range(len(res.time)):
+        assert np.allclose([res[f"y[{i}]"][k] for i in (1, 2, 3)], x, rtol=1e-12, atol=1e-14)
+        x = np.linalg.matrix_power(step, 10) @ x
+    assert np.max(np.abs(res["y[3]"][-1] - (expm(A) @ X0)[2])) > 1e-3   # not the exact one
+    down = simulate_fmu(c_fmus["Countdown"], stop_time=2.5, interval=0.5, interface="me",
+                        euler_step=0.1)
+    assert list(down["counter"]) == [3, 3, 2, 2, 1, 1]
+    assert list(down["label"]) == ["left 3", "left 3", "left 2", "left 2", "left 1", "left 1"]
+    from bgmodelica.cli import main
+
+    assert main(["cosim", str(c_fmus["StateSpace"]), "--interface", "me", "--euler-step",
+                 "0", "-o", str(tmp_path / "x.csv")]) == 2
+    assert "me_euler_step must be > 0" in capsys.readouterr().err
