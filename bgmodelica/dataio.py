@@ -49,6 +49,13 @@ def _names(result: Result, names: Sequence[str] | None) -> list[str]:
     return list(names) if names is not None else result.all_names()
 
 
+def text_cell(value: Any) -> str:
+    """A String value as it is, a Binary one (bytes) in hex, as CSV files hold them."""
+    if isinstance(value, (bytes, bytearray)):
+        return bytes(value).hex()
+    return "" if value is None else str(value)
+
+
 def _meta_attrs(result: Result) -> dict[str, Any]:
     attrs: dict[str, Any] = {}
     events = result.meta.get("event_times")
@@ -151,9 +158,14 @@ def write_csv(result: Result, path: str | Path, names: Sequence[str] | None = No
               progress: Callable[[float], None] | None = None) -> Path:
     """``time,<names>`` per row; with ``units`` a second header row holds the units
     (``s,V,A,...``; an empty cell for a dimensionless or undeclared one). ``progress`` is
-    called with the fraction written after each block of rows."""
+    called with the fraction written after each block of rows. String columns (of
+    ``result.text``; by default after the others) are written as text, Binary ones in hex."""
     cols = _names(result, names)
-    table = _table(result, cols)
+    if names is None:
+        cols += list(result.text)
+    texts = [n for n in cols if n in result.text]
+    numeric = [n for n in cols if n not in result.text]
+    table = _table(result, numeric)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     row = ",".join([fmt] * table.shape[1])
@@ -162,6 +174,13 @@ def write_csv(result: Result, path: str | Path, names: Sequence[str] | None = No
         writer.writerow(["time", *cols])
         if units:
             writer.writerow([UNITS_ROW, *[unit_of(result, n) for n in cols]])
+        if texts:                                   # row by row, columns in the given order
+            where = {n: k + 1 for k, n in enumerate(numeric)}
+            for i, r in enumerate(table.tolist()):
+                writer.writerow([fmt % r[0], *[fmt % r[where[n]] if n in where
+                                               else text_cell(result.text[n][i])
+                                               for n in cols]])
+            return path
         for start in range(0, len(table), 256):          # in bulk: one format per row
             fh.write("\r\n".join(row % tuple(r) for r in table[start:start + 256].tolist()))
             fh.write("\r\n")
@@ -225,7 +244,14 @@ def read_csv(path: str | Path) -> Result:
     if body and body[0] and not _is_number(body[0][0]):   # the units row: "s", ...
         units = {n: u.strip() for n, u in zip(header, body[0], strict=False)}
         body = body[1:]
-    table = np.array([[float(c) if c.strip() else math.nan for c in r] for r in body
-                      if r], dtype=float).reshape(-1, len(header))
-    cols = {n: table[:, k] for k, n in enumerate(header[1:], start=1)}
-    return _result(table[:, 0], cols, units, {}, {})
+    body = [r for r in body if r]
+    texts = {k for k in range(1, len(header))
+             if any(r[k].strip() and not _is_number(r[k]) for r in body if k < len(r))}
+    table = np.array([[float(c) if c.strip() else math.nan
+                       for k, c in enumerate(r) if k not in texts] for r in body],
+                     dtype=float).reshape(-1, len(header) - len(texts))
+    numeric = [n for k, n in enumerate(header) if k not in texts]
+    cols = {n: table[:, k] for k, n in enumerate(numeric[1:], start=1)}
+    result = _result(table[:, 0], cols, units, {}, {})
+    result.text = {header[k]: [r[k] for r in body] for k in sorted(texts)}
+    return result

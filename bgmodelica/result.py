@@ -17,6 +17,8 @@ class Result:
     time: [s], shape (N,). ``result["motor.R.i"]`` gives a variable (aliases and parameters
     included). ``meta`` holds solver statistics and compile/run times [s]. The variables
     other than the states are computed from the trajectory when first asked for.
+    ``text``: String (``str``) and Binary (``bytes``) variables of a co-simulation, name ->
+    one value per time point; ``result[name]`` gives them as an object array.
     """
 
     time: np.ndarray
@@ -26,6 +28,7 @@ class Result:
     parameters: dict[str, float] = field(default_factory=dict)
     units: dict[str, str] = field(default_factory=dict)
     meta: dict[str, Any] = field(default_factory=dict)
+    text: dict[str, list[Any]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self._index = {n: k for k, n in enumerate(self.names)}
@@ -46,7 +49,8 @@ class Result:
         return self.data
 
     def __contains__(self, name: str) -> bool:
-        return name in self._index or name in self.aliases or name in self.parameters
+        return (name in self._index or name in self.aliases or name in self.parameters
+                or name in self.text)
 
     def __getitem__(self, name: str) -> np.ndarray:
         if name in ("time", "t"):
@@ -58,6 +62,10 @@ class Result:
             return sign * self[rep]
         if name in self.parameters:
             return np.full_like(self.time, self.parameters[name])
+        if name in self.text:
+            out = np.empty(len(self.text[name]), dtype=object)
+            out[:] = self.text[name]
+            return out
         close = [n for n in self.all_names() if n.endswith(name.split(".")[-1])][:6]
         raise KeyError(f"no variable {name!r} in the result"
                        + (f"; similar: {', '.join(close)}" if close else ""))
@@ -84,9 +92,10 @@ class Result:
 
     def to_csv(self, path: str | Path, names: Sequence[str] | None = None, *,
                units: bool = False) -> Path:
-        """Write ``time,<names>`` (default: every variable incl. aliases) to a CSV file;
-        ``units=True`` adds a second header row with the units (``s,V,A,...``). At an event
-        instant there are two rows with the same time (left and right limit).
+        """Write ``time,<names>`` (default: every variable incl. aliases, then the ``text``
+        ones: a String as text, a Binary in hex) to a CSV file; ``units=True`` adds a second
+        header row with the units (``s,V,A,...``). At an event instant there are two rows
+        with the same time (left and right limit).
         :meth:`read_csv` reads it back."""
         from .dataio import write_csv
 

@@ -22,7 +22,7 @@ graph that orders the evaluation of outputs at a communication point.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -53,6 +53,8 @@ class Plan:
     by a connection, then the other outputs); ``sources[(el, input)] = (el, output)``;
     ``order``: every connector node ``(el, name, is_output)`` in an order where each output
     comes after the inputs it depends on directly and each input after its source output.
+    String and Binary connectors are apart (they are no numeric signals, :mod:`.text`):
+    ``text_inputs[el]``, ``text_outputs[el]``, ``text_sources[(el, input)] = (el, output)``.
     """
 
     inputs: dict[str, list[str]]
@@ -95,6 +97,9 @@ class Plan:
                                  for yn in self.outputs[n]], dtype=bool)
         return groups, stale
     unconnected: list[str]
+    text_inputs: dict[str, list[str]] = field(default_factory=dict)
+    text_outputs: dict[str, list[str]] = field(default_factory=dict)
+    text_sources: dict[tuple[str, str], tuple[str, str]] = field(default_factory=dict)
 
 
 def units_compatible(a: str, b: str) -> bool:
@@ -186,6 +191,7 @@ def check_system(system: SystemStructure, infos: dict[str, FmuInfo],
                                   unit=comp.parameter_units.get(pname, ""))
 
     sources: dict[tuple[str, str], tuple[str, str]] = {}
+    text_sources: dict[tuple[str, str], tuple[str, str]] = {}
     used_outputs: dict[str, list[str]] = {n: [] for n in names}
     for con in system.connections:
         for el in (con.start_element, con.end_element):
@@ -216,19 +222,18 @@ def check_system(system: SystemStructure, infos: dict[str, FmuInfo],
             raise ConnectorMismatchError(
                 f"connection {con}: type mismatch, {con.start} is {a.type} and {con.end} is "
                 f"{b.type}")
-        if a.type in ("String", "Binary"):
-            raise ConnectorMismatchError(
-                f"connection {con}: {a.type} variables cannot be connected (only numeric, "
-                "Boolean and enumeration signals can); set them as parameters instead")
         if not units_compatible(a.unit, b.unit):
             raise ConnectorMismatchError(
                 f"connection {con}: unit mismatch, {con.start} is in {a.unit!r} and "
                 f"{con.end} in {b.unit!r}")
         key = (con.end_element, con.end_connector)
-        if key in sources:
-            other = "{}.{}".format(*sources[key])
+        if key in sources or key in text_sources:
+            other = "{}.{}".format(*(sources.get(key) or text_sources[key]))
             raise ConnectorMismatchError(
                 f"input {con.end} is driven twice: by {other} and by {con.start}")
+        if a.type in NOT_SIGNALS:
+            text_sources[key] = (con.start_element, con.start_connector)
+            continue
         sources[key] = (con.start_element, con.start_connector)
         if con.start_connector not in used_outputs[con.start_element]:
             used_outputs[con.start_element].append(con.start_connector)
@@ -245,7 +250,10 @@ def check_system(system: SystemStructure, infos: dict[str, FmuInfo],
                                      and v.type not in NOT_SIGNALS] for n in names}
     feed = {n: infos[n].feedthrough for n in names}
     order = _evaluation_order(names, inputs, outputs, sources, feed)
-    return Plan(inputs, outputs, sources, order, feed, unconnected)
+    text_in = {n: [v.name for v in infos[n].inputs if v.type in NOT_SIGNALS] for n in names}
+    text_out = {n: [v.name for v in infos[n].outputs if v.type in NOT_SIGNALS] for n in names}
+    return Plan(inputs, outputs, sources, order, feed, unconnected, text_in, text_out,
+                text_sources)
 
 
 def _evaluation_order(names, inputs, outputs, sources, feed) -> list[tuple[str, str, bool]]:

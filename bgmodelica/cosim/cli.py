@@ -5,6 +5,10 @@
     co-simulate an SSP set-up with the fixed-step master (``--extrapolation``,
     ``--interface cs|me|auto``, ``--no-propagate``, ``--set ELEMENT.NAME=VALUE``,
     ``--record ELEMENT.VAR``, ``--plot out.png``).
+``bgmodelica cosim MODEL.fmu [--step H] [--stop-time T] [--input in.csv] [-o out.csv]``
+    one FMU through the same master (:func:`~.single.simulate_fmu`): ``--step`` is the
+    communication and output interval, ``--set NAME=VALUE`` (any type), ``--record VAR``,
+    ``--interface`` (default auto: CS when the FMU has it); the same as ``simulate-fmu``.
 ``bgmodelica verify MODEL SSP [--step 4e-3,2e-3,1e-3] [--stop-time T] [--tolerance TOL] [--json]``
     any model, monolithic vs the co-simulation of its parts (variables matched by name,
     :func:`~.verify.verify_model`): error table per variable, observed convergence order,
@@ -82,14 +86,23 @@ def _write_atomically(path: Path, write: Callable[[Path], Any], what: str) -> No
         raise
 
 
+def _is_fmu(path: str) -> bool:
+    return Path(path).suffix.lower() == ".fmu"
+
+
 def cmd_cosim(args: argparse.Namespace) -> int:
-    """``bgmodelica cosim``: run an SSP set-up, write the CSV (and a plot)."""
+    """``bgmodelica cosim``: run an SSP set-up (or one FMU), write the CSV (and a plot)."""
     from .master import Master
     from .ssp_read import read_ssp
 
     for value, what in ((args.stop_time, "--stop-time"), (args.step, "--step")):
         if value is not None and not (math.isfinite(value) and value > 0):
             raise InvalidExperimentError(f"{what} must be a finite number > 0, got {value}")
+    if _is_fmu(args.ssp):
+        return _run_fmu(args, args.ssp, args.step, "_cosim")
+    if args.input:
+        raise CosimError("--input is for a single FMU; an SSP set-up drives its inputs "
+                         "with connections")
     sets = _sets(args.set)
     out_arg = _writable(args.output, "output file")
     plot = _writable(args.plot, "plot")
@@ -97,7 +110,7 @@ def cmd_cosim(args: argparse.Namespace) -> int:
     safe = re.sub(r"[^A-Za-z0-9_.-]", "_", system.name).lstrip(".") or "system"
     out = out_arg or _writable(f"{safe}_cosim.csv", "output file")   # in the working folder
     assert out is not None
-    master = Master(system, interface=args.interface)
+    master = Master(system, interface=args.interface or "cs", me_euler_step=args.euler_step)
     order = args.order or system.master.get("order", "jacobi")
     extrapolation = args.extrapolation
     if extrapolation is None:
@@ -129,11 +142,17 @@ def cmd_cosim(args: argparse.Namespace) -> int:
 
 def cmd_simulate_fmu(args: argparse.Namespace) -> int:
     """``bgmodelica simulate-fmu``: one FMU through the master, results to CSV."""
-    from .single import simulate_fmu
-
     for value, what in ((args.stop_time, "--stop-time"), (args.interval, "--interval")):
         if value is not None and not (math.isfinite(value) and value > 0):
             raise InvalidExperimentError(f"{what} must be a finite number > 0, got {value}")
+    return _run_fmu(args, args.fmu, args.interval, "")
+
+
+def _run_fmu(args: argparse.Namespace, fmu: str, interval: float | None, suffix: str) -> int:
+    """One FMU through the master (``simulate-fmu``, ``cosim MODEL.fmu``): the CSV at ``-o``
+    (default ``<model><suffix>.csv``) and the optional plot."""
+    from .single import simulate_fmu
+
     sets = {}
     for item in args.set:
         name, sep, value = item.partition("=")
@@ -141,10 +160,16 @@ def cmd_simulate_fmu(args: argparse.Namespace) -> int:
             raise CosimError(f"--set {item!r}: expected NAME=VALUE")
         sets[name.strip()] = value.strip()
     out_arg = _writable(args.output, "output file")
-    res = simulate_fmu(args.fmu, stop_time=args.stop_time, interval=args.interval,
-                       parameters=sets, inputs=args.input, interface=args.interface,
-                       rtol=args.rtol, atol=args.atol, record=args.record)
-    out = out_arg or _writable(f"{res.meta['model']}.csv", "output file")
+    plot = _writable(getattr(args, "plot", None), "plot")
+    res = simulate_fmu(fmu, stop_time=args.stop_time, interval=interval,
+                       parameters=sets, inputs=args.input, interface=args.interface or "auto",
+                       rtol=getattr(args, "rtol", 1e-8), atol=getattr(args, "atol", 1e-10),
+                       record=args.record, euler_step=args.euler_step)
+    names = getattr(args, "plot_vars", None)
+    missing = [n for n in names or () if n not in res.names]
+    if missing:
+        raise CosimError(f"--plot-vars: no numeric result variable {', '.join(missing)}")
+    out = out_arg or _writable(f"{res.meta['model']}{suffix}.csv", "output file")
     assert out is not None
     _write_atomically(out, res.to_csv, "output file")
     meta = res.meta
@@ -156,6 +181,10 @@ def cmd_simulate_fmu(args: argparse.Namespace) -> int:
         print(f"events: {len(meta['events'])} (first at t = {meta['events'][0]:.10g} s)")
     if meta.get("terminated"):
         print(f"note: {meta['terminated']['reason']} at t = {meta['terminated']['time']:g} s")
+    if plot is not None:
+        chosen = names or res.names[:6]
+        _write_atomically(plot, lambda tmp: res.plot(chosen, tmp, title=meta["model"]), "plot")
+        print(f"plot -> {plot}")
     return 0
 
 
@@ -216,27 +245,37 @@ def cmd_verify(args: argparse.Namespace) -> int:
 def register(sub: Any, model_args: Any = None) -> None:
     """Add the ``cosim`` and ``verify`` subcommands to the ``bgmodelica`` parser (``sub``:
     its subparsers; ``model_args(parser)`` adds the MODEL argument and ``--arg``)."""
-    cos = sub.add_parser("cosim", help="co-simulate an SSP set-up of FMUs (fixed-step master)")
-    cos.add_argument("ssp", help="the .ssp file (SystemStructure.ssd + FMUs in resources/)")
+    cos = sub.add_parser("cosim", help="co-simulate an SSP set-up of FMUs, or one FMU "
+                                       "(fixed-step master)")
+    cos.add_argument("ssp", metavar="SSP|FMU",
+                     help="the .ssp file (SystemStructure.ssd + FMUs in resources/), or one "
+                          ".fmu")
     cos.add_argument("--step", type=float, default=None,
-                     help="macro step [s] (default: the SSP's, else 1e-3)")
+                     help="macro step [s] (default: the SSP's, else 1e-3; one FMU: its "
+                          "step size, else 1/500 of the horizon)")
     cos.add_argument("--order", choices=["jacobi", "gauss-seidel"], default=None,
                      help="coupling order (default: the SSP's, else jacobi)")
     cos.add_argument("--stop-time", type=float, default=None,
                      help="[s] (default: the SSP DefaultExperiment)")
     cos.add_argument("--extrapolation", action=argparse.BooleanOptionalAction, default=None,
                      help="linear extrapolation (interpolation in Gauss-Seidel) of the inputs")
-    cos.add_argument("--interface", choices=["cs", "me", "auto"], default="cs",
+    cos.add_argument("--interface", choices=["cs", "me", "auto"], default=None,
                      help="Co-Simulation FMUs (own solvers) or Model Exchange (master's "
-                          "integrator)")
+                          "integrator); default cs, for one FMU auto (CS when available)")
     cos.add_argument("--no-propagate", action="store_true",
                      help="read outputs right after doStep (no feedthrough evaluation at "
                           "communication points)")
     cos.add_argument("--set", action="append", default=[], metavar="ELEMENT.NAME=VALUE",
-                     help="override a parameter of an element")
+                     help="override a parameter of an element (one FMU: NAME=VALUE)")
     cos.add_argument("--record", nargs="+", metavar="ELEMENT.VAR",
-                     help="record more variables (locals, states)")
-    cos.add_argument("-o", "--output", help="CSV file (default <system>_cosim.csv)")
+                     help="record more variables (locals, states; one FMU: VAR)")
+    cos.add_argument("--euler-step", type=float, default=None, metavar="H",
+                     help="Model Exchange units: forward Euler at this fixed step (the FMI "
+                          "example importer) instead of Radau")
+    cos.add_argument("--input", metavar="CSV",
+                     help="one FMU: input signals, a 'time' column then one per input")
+    cos.add_argument("-o", "--output", help="CSV file (default <system>_cosim.csv, one FMU: "
+                                            "<model>_cosim.csv)")
     cos.add_argument("--plot", help="PNG with the first element's connectors (or --plot-vars)")
     cos.add_argument("--plot-vars", nargs="+", help="variables to plot")
     cos.set_defaults(func=cmd_cosim)
@@ -259,6 +298,9 @@ def register(sub: Any, model_args: Any = None) -> None:
     one.add_argument("--rtol", type=float, default=1e-8,
                      help="Model Exchange rtol, and the FMU's experiment tolerance")
     one.add_argument("--atol", type=float, default=1e-10, help="Model Exchange atol")
+    one.add_argument("--euler-step", type=float, default=None, metavar="H",
+                     help="Model Exchange: forward Euler at this fixed step (the FMI example "
+                          "importer) instead of Radau")
     one.add_argument("--record", nargs="+", metavar="VAR",
                      help="variables to record besides the outputs (default: the states)")
     one.add_argument("-o", "--output", help="CSV file (default <model>.csv)")

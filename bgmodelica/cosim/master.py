@@ -68,62 +68,15 @@ from .errors import (
     SetupError,
     UnknownConnectorError,
 )
+from .experiment import MAX_STEPS, ORDERS, _finite, _norm_order, count_steps  # noqa: F401
 from .fmu import FmuInfo, read_fmu_info
 from .signals import input_signals
 from .ssp import SystemStructure
 from .ssp_read import read_ssp
+from .text import TextChannel
 from .units import make_unit
 
-ORDERS = ("jacobi", "gauss-seidel")
-MAX_STEPS = 100_000_000              # macro steps of one run (1e8: hours of FMU calls)
 MAX_RECORD_BYTES = 4 << 30           # the recorded table (points x columns x 8 bytes)
-
-
-def _finite(value: Any, what: str) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise InvalidExperimentError(f"{what} {value!r} is not a number") from None
-    if not math.isfinite(x):
-        raise InvalidExperimentError(f"{what} {x} is not finite")
-    return x
-
-
-def count_steps(start_time: Any, stop_time: Any, step: Any,
-                max_steps: int | None = None) -> int:
-    """The number of macro steps ``step`` from ``start_time`` to ``stop_time``; raises
-    :class:`~.errors.InvalidExperimentError` unless all are finite, ``step > 0``, the
-    horizon positive and a multiple of the step, and the count at most ``max_steps``
-    (default :data:`MAX_STEPS`)."""
-    t0 = _finite(start_time, "start time")
-    t1 = _finite(stop_time, "stop time")
-    h = _finite(step, "macro step")
-    limit = MAX_STEPS if max_steps is None else int(max_steps)
-    if not h > 0:
-        raise InvalidExperimentError(f"macro step must be > 0, got {h:g}")
-    span = t1 - t0
-    if not span > 0 or not math.isfinite(span):
-        raise InvalidExperimentError(f"stop time {t1:g} must be after the start time {t0:g}")
-    ratio = span / h
-    if not math.isfinite(ratio) or ratio > limit + 0.5:
-        raise InvalidExperimentError(
-            f"the horizon {span:g} s at macro step {h:g} s needs {ratio:.4g} macro steps, "
-            f"more than the limit of {limit:.4g} (a wrong unit or a typo in the stop time or "
-            "step? Master.simulate(max_steps=...) allows more)")
-    n_steps = int(round(ratio))
-    if n_steps < 1 or abs(n_steps * h - span) > 1e-9 * max(1.0, span):
-        raise InvalidExperimentError(f"the horizon {span:g} s is not a multiple of the macro "
-                                     f"step {h:g} s")
-    return n_steps
-
-
-def _norm_order(order: str) -> str:
-    o = str(order).lower().replace("_", "-")
-    if o in ("gs", "gauss-seidel", "gaussseidel", "seidel", "sequential"):
-        return "gauss-seidel"
-    if o in ("jacobi", "parallel"):
-        return "jacobi"
-    raise SetupError(f"order must be 'jacobi' or 'gauss-seidel', not {order!r}")
 
 
 class Master:
@@ -133,12 +86,14 @@ class Master:
     ``interface``: ``"cs"`` (default), ``"me"``, ``"auto"`` (the SSD ``implementation``
     attribute, else CS when available) or a dict element -> interface.
     ``allow_unconnected``: keep unconnected inputs at their start values instead of raising.
-    ``me_rtol``/``me_atol``: tolerances of the Model Exchange integrator.
+    ``me_rtol``/``me_atol``: tolerances of the Model Exchange integrator; ``me_euler_step``:
+    forward Euler at this fixed step instead (see :mod:`.me_unit`).
     """
 
     def __init__(self, system: SystemStructure | str | Path, *,
                  interface: str | Mapping[str, str] = "cs", allow_unconnected: bool = False,
-                 me_rtol: float = 1e-8, me_atol: float = 1e-10) -> None:
+                 me_rtol: float = 1e-8, me_atol: float = 1e-10,
+                 me_euler_step: float | None = None) -> None:
         if not isinstance(system, SystemStructure):
             system = read_ssp(system)
         self.system = system
@@ -160,7 +115,9 @@ class Master:
                 raise InvalidExperimentError(f"{name} must be finite and > 0, got {tol!r}")
         self.interfaces = {c.name: self._interface(c.name, c.implementation, interface)
                            for c in system.elements}
-        self.me_rtol, self.me_atol = me_rtol, me_atol
+        if me_euler_step is not None and not _finite(me_euler_step, "me_euler_step") > 0:
+            raise InvalidExperimentError(f"me_euler_step must be > 0, got {me_euler_step!r}")
+        self.me_rtol, self.me_atol, self.me_euler_step = me_rtol, me_atol, me_euler_step
 
     def _interface(self, name: str, implementation: str, wanted: Any) -> str:
         info = self.infos[name]
@@ -247,13 +204,15 @@ class Master:
                 params[el][p] = check_parameter_value(el, self.infos[el], p, v,
                                                       "parameter override")
         extra: dict[str, list[str]] = {n: [] for n in names}
+        text_extra: dict[str, list[str]] = {n: [] for n in names}
         for full in record:
             el, _, var = full.partition(".")
             if el not in extra or not var:
                 raise UnknownConnectorError(f"record: {full!r} is not <element>.<variable> "
                                             f"(elements: {', '.join(names)})")
-            self.infos[el].variable(var, el)
-            extra[el].append(var)
+            is_text = self.infos[el].variable(var, el).type in ("String", "Binary")
+            (text_extra if is_text else extra)[el].append(var)
+        text = TextChannel(plan, self.infos, names, text_extra)
         n_cols = sum(len(plan.inputs[n]) + len(plan.outputs[n]) + len(extra[n])
                      for n in names)
         n_rows = n_steps // every + 1 + (1 if n_steps % every else 0)
@@ -290,7 +249,8 @@ class Master:
             for comp in system.elements:
                 n = comp.name
                 unit = make_unit(n, self.infos[n], self.interfaces[n], plan.inputs[n],
-                                 plan.outputs[n], rtol=self.me_rtol, atol=self.me_atol)
+                                 plan.outputs[n], rtol=self.me_rtol, atol=self.me_atol,
+                                 euler_step=self.me_euler_step)
                 units[n] = unit
                 pset = {k: v for k, v in params[n].items()
                         if self.infos[n].variables[k].set_by_name}
@@ -334,6 +294,8 @@ class Master:
 
             if propagate:
                 propagate_outputs()
+            if text:
+                text.start(units)
             wall_setup = _time.perf_counter() - wall0
 
             # recording ------------------------------------------------------------------
@@ -362,6 +324,8 @@ class Master:
                 data[row] = np.concatenate(parts) if parts else []
                 times[row] = t
                 row += 1
+                if text:
+                    text.record()
 
             def diverging(ys: dict[str, np.ndarray], t: float) -> None:
                 """Raise when an output at ``t + h`` is not finite (or exceeds max_abs)."""
@@ -382,8 +346,8 @@ class Master:
             terminated: dict[str, Any] | None = None
             u_prev: dict[str, np.ndarray] | None = None
             wall1 = _time.perf_counter()
-            if flat_loop.applies(units, order=order, extrapolation=extrapolation,
-                                 signals=signals):
+            if not text and flat_loop.applies(units, order=order,
+                                              extrapolation=extrapolation, signals=signals):
                 loop = flat_loop.FlatLoop(units, names, start_u, gather, feed_order, extra)
                 loop.load(y)
                 row, terminated = loop.run(
@@ -443,6 +407,8 @@ class Master:
                             last_set[n] = np.full(len(u_now[n]), np.nan)
                     if propagate:
                         propagate_outputs()
+                    if text:
+                        text.exchange()
                     u_prev = u_now
                     stopped = [n for n in names if units[n].terminated]
                     if stopped:
@@ -471,6 +437,7 @@ class Master:
         for n in names:
             for v in plan.inputs[n] + plan.outputs[n] + extra[n]:
                 units_of[f"{n}.{v}"] = self.infos[n].variables[v].unit
+        units_of.update(text.units_of)
         meta = {
             "master": "bgmodelica.cosim", "order": order, "extrapolation": bool(extrapolation),
             "propagate": bool(propagate), "step": h, "steps": n_steps, "start_time": t0,
@@ -485,7 +452,7 @@ class Master:
                                    if self.interfaces[n] == "me"},
         }
         return Result(times[:row], data[:row], cols, parameters=parameters_out, units=units_of,
-                      meta=meta)
+                      meta=meta, text=text.table())
 
 
 def cosimulate(system: SystemStructure | str | Path, stop_time: float | None = None,

@@ -13,6 +13,10 @@ step it
 * iterates each event to a fixed point (``newDiscreteStates`` / ``updateDiscreteStates``),
   re-reads the states when the FMU changed them, and honours a terminate request;
 * sets discrete inputs (Integer, Boolean, discrete Real) only at event instants, in event mode.
+
+With ``euler_step`` it integrates instead with forward Euler at that fixed step, an event
+taken at the end of the step where an indicator changed sign (no location): the algorithm of
+the FMI standard's example importer, with which the Modelica Reference-FMUs results were made.
 """
 
 from __future__ import annotations
@@ -20,6 +24,7 @@ from __future__ import annotations
 import ctypes
 import functools
 import math
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -41,8 +46,9 @@ class ModelExchangeUnit(_Unit):
     interface = "me"
 
     def __init__(self, *args: Any, rtol: float = 1e-8, atol: float = 1e-10,
-                 event_tol: float = 1e-12, **kw: Any) -> None:
+                 event_tol: float = 1e-12, euler_step: float | None = None, **kw: Any) -> None:
         super().__init__(*args, **kw)
+        self.euler_step = euler_step
         self.rtol = rtol
         self.atol = atol
         self.event_tol = event_tol
@@ -78,6 +84,13 @@ class ModelExchangeUnit(_Unit):
                     self._event(lambda: self._in_disc.set(self.fmu, d))
                 self._disc_set = d.copy()
 
+    def set_text(self, values: Mapping[str, Any]) -> None:
+        """String/Binary inputs are discrete: set in event mode once the run has started."""
+        if values and getattr(self, "_running", False):
+            self._event(lambda: self.set_values(values))
+        else:
+            self.set_values(values)
+
     def _set_continuous_inputs(self, values: np.ndarray) -> None:
         if len(self._cont):
             self._in_cont.set(self.fmu, np.asarray(values, dtype=float)[self._cont])
@@ -104,6 +117,7 @@ class ModelExchangeUnit(_Unit):
             self.x = np.zeros(self.nx)
         self._iterate()                       # the initial event iteration (event mode)
         self._get_states()
+        self._running = True
 
     # FMU calls ----------------------------------------------------------------------------------
     def _ptr(self, arr: np.ndarray) -> Any:
@@ -236,7 +250,8 @@ class ModelExchangeUnit(_Unit):
                 self._call(self._set_state, tc, self.x)
                 self._set_continuous_inputs(u0 if slope is None else u0 + slope * (tc - t))
             elif t_stop > tc:
-                tc = self._integrate(tc, t_stop, args, Radau)
+                tc = self._euler(tc, t_stop, args) if self.euler_step else \
+                    self._integrate(tc, t_stop, args, Radau)
             if self.terminated:
                 break
             if tc >= t_stop and time_event and (self.next_event is None
@@ -312,6 +327,34 @@ class ModelExchangeUnit(_Unit):
             if solver is None or solver.status == "finished" or t_new >= t_stop:
                 return t_stop
             t_old = t_new
+
+    def _euler(self, tc: float, t_stop: float, args: tuple) -> float:
+        """Forward Euler steps of ``euler_step`` from ``tc`` towards ``t_stop``; return the
+        time reached (``t_stop``, or the end of the step with a state or step event)."""
+        z_prev = self._indicators(tc, self.x, *args) if self.nz else self._z
+        t0, k = tc, 0
+        while tc < t_stop:
+            k += 1
+            t_new = t0 + k * self.euler_step
+            if t_new >= t_stop - 1e-12 * max(1.0, abs(t_stop)):
+                t_new = t_stop
+            dx = self._rhs(tc, self.x, *args) if self.nx else self.x
+            self.x = self.x + (t_new - tc) * dx
+            tc = self.time = t_new
+            if not np.all(np.isfinite(self.x)):
+                raise self._failure(tc, "the states are not finite")
+            z_new = self._indicators(tc, self.x, *args) if self.nz else \
+                self._call(self._set_state, tc, self.x)
+            enter, term = self._call(self.fmu.completedIntegratorStep)
+            if term:
+                self._request_stop("the FMU asked to terminate the simulation "
+                                   "(completedIntegratorStep)")
+                return tc
+            if enter or (self.nz and _crossed(z_prev, z_new).any()):
+                self._event()
+                return tc
+            z_prev = z_new
+        return t_stop
 
     def _state_at(self, t0: float, x0: np.ndarray, t1: float, *, fun: Any,
                   Radau: Any) -> np.ndarray:

@@ -3,8 +3,9 @@
 
 The result has the same conventions as :func:`bgmodelica.simulate`: a ``time`` column and one
 column per variable under the FMU's own names (array elements as ``x[1]``...), Booleans as
-0/1. Inputs come from a CSV (``time`` first, one column per input; linear between rows, a
-repeated time is a jump, the last row held) or a mapping ``{name: (times, values)}``; inputs
+0/1; String and Binary variables are in ``result.text`` (``str``, ``bytes``). Inputs come
+from a CSV (``time`` first, one column per input; linear between rows, a repeated time is a
+jump, the last row held) or a mapping ``{name: (times, values)}``; inputs
 without data keep their start values.
 """
 
@@ -41,7 +42,8 @@ def simulate_fmu(fmu: str | Path, *, stop_time: float | None = None,
                  interval: float | None = None, start_time: float | None = None,
                  parameters: Mapping[str, Any] | None = None, inputs: Any = None,
                  interface: str = "auto", rtol: float = 1e-8, atol: float = 1e-10,
-                 record: Iterable[str] | None = None) -> Result:
+                 record: Iterable[str] | None = None,
+                 euler_step: float | None = None) -> Result:
     """Simulate the FMU at ``fmu`` from ``start_time`` to ``stop_time`` [s] (defaults: its
     DefaultExperiment, else 0 and 1 s) with results every ``interval`` [s] (default: its
     step size, else 1/500 of the horizon), which is also the communication step.
@@ -51,7 +53,8 @@ def simulate_fmu(fmu: str | Path, *, stop_time: float | None = None,
     (the master's integrator with events, tolerances ``rtol``/``atol``) or ``"auto"`` (CS
     when the FMU has it); ``rtol`` also goes to the FMU as its experiment tolerance (the
     embedded solver of a Co-Simulation FMU may use it). ``record``: variables to record
-    besides the outputs (default: the continuous states).
+    besides the outputs (default: the continuous states). ``euler_step``: Model Exchange
+    with forward Euler at this fixed step instead of the error-controlled Radau.
     """
     info = read_fmu_info(fmu)
     md = info.description
@@ -83,11 +86,10 @@ def simulate_fmu(fmu: str | Path, *, stop_time: float | None = None,
         info.variable(name)
     system = system_from_fmus(info.model_name, {ELEMENT: info.path}, [])
     master = Master(system, interface=interface, allow_unconnected=True, me_rtol=rtol,
-                    me_atol=atol)
+                    me_atol=atol, me_euler_step=euler_step)
     result = master.simulate(t1, h, start_time=t0,
                              parameters={ELEMENT: dict(parameters or {})},
-                             record=[f"{ELEMENT}.{n}" for n in extra if info.variables[n].type
-                                     not in ("String", "Binary")],
+                             record=[f"{ELEMENT}.{n}" for n in extra],
                              inputs={f"{ELEMENT}.{k}": v for k, v in table.items()},
                              tolerance=rtol)
     prefix = ELEMENT + "."
@@ -101,4 +103,5 @@ def simulate_fmu(fmu: str | Path, *, stop_time: float | None = None,
         meta["events"] = meta["events"].get(ELEMENT, [])
     return Result(result.time, result.values, columns,
                   parameters={k[len(prefix):]: v for k, v in result.parameters.items()},
-                  units={k[len(prefix):]: v for k, v in result.units.items()}, meta=meta)
+                  units={k[len(prefix):]: v for k, v in result.units.items()}, meta=meta,
+                  text={k[len(prefix):]: v for k, v in result.text.items()})

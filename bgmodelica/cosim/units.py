@@ -31,7 +31,7 @@ import numpy as np
 from .archive import _one_line
 from .errors import CosimStepError, SetupError
 from .fmu import _EXTRACTED, FmuInfo
-from .values import PortAccess, set_by_name, to_fmi
+from .values import PortAccess, get_text, set_by_name, to_fmi
 
 # FMI 2.0 log messages are variadic; fmpy formats them with a native proxy that forwards to
 # ONE process-wide Python logger (a C global set by ``addLoggerProxy``). That logger must
@@ -196,6 +196,15 @@ class _Unit:
                 raise SetupError(f"element {self.name!r}: {err}") from None
             self._readers[key] = reader
         return self._call(reader.get, self.fmu, np.zeros(len(names)))
+
+    def get_text(self, names: list[str]) -> list[Any]:
+        """Values of String (``str``) and Binary (``bytes``) variables by name."""
+        variables = [self.info.variable(n, self.name) for n in names]
+        return self._call(get_text, self.fmu, self.info.fmi_version, variables)
+
+    def set_text(self, values: Mapping[str, Any]) -> None:
+        """Set String/Binary inputs during the run (a Model Exchange unit at an event)."""
+        self.set_values(values)
 
     def set_values(self, values: Mapping[str, Any]) -> None:
         """Set variables of any type by name (parameters, start values, tunable parameters;
@@ -401,12 +410,15 @@ class CoSimUnit(_Unit):
 
 
 def make_unit(name: str, info: FmuInfo, interface: str, input_names: list[str],
-              output_names: list[str], *, rtol: float = 1e-8, atol: float = 1e-10) -> _Unit:
-    """A :class:`CoSimUnit` (``interface="cs"``) or :class:`ModelExchangeUnit` (``"me"``)."""
+              output_names: list[str], *, rtol: float = 1e-8, atol: float = 1e-10,
+              euler_step: float | None = None) -> _Unit:
+    """A :class:`CoSimUnit` (``interface="cs"``) or :class:`ModelExchangeUnit` (``"me"``;
+    ``euler_step``: forward Euler at that step instead of Radau)."""
     if interface == "cs":
         return CoSimUnit(name, info, input_names, output_names)
     if interface == "me":
         from .me_unit import ModelExchangeUnit
 
-        return ModelExchangeUnit(name, info, input_names, output_names, rtol=rtol, atol=atol)
+        return ModelExchangeUnit(name, info, input_names, output_names, rtol=rtol, atol=atol,
+                                 euler_step=euler_step)
     raise SetupError(f"element {name!r}: interface must be 'cs' or 'me', not {interface!r}")

@@ -7,8 +7,10 @@ variables appear to the master as their elements ``x[1]``, ``x[2]``... (row-majo
 ``A[i,j]`` for matrices); an array is always read and written whole, the elements the master
 does not set keep their last written (or start) value.
 
-String and Binary variables are not signals: they can be set by name (parameters, start
-values) with :meth:`PortAccess.set_values` but not connected.
+String and Binary variables are not numeric signals: they are read with :func:`get_text`
+and written by name with :func:`set_by_name` (parameters, start values, and the values the
+master passes along String/Binary connections, see :mod:`.text`). The master holds a String
+as ``str`` and a Binary as ``bytes``.
 """
 
 from __future__ import annotations
@@ -177,3 +179,31 @@ def set_by_name(fmu: Any, fmi_version: int, variables: Sequence[FmuVariable],
         elif kind not in ("Real", "Float64", "Float32", "String", "Binary"):
             flat = [int(x) for x in flat]
         getattr(fmu, "set" + kind)(vrs, flat)
+
+
+def get_text(fmu: Any, fmi_version: int, variables: Sequence[FmuVariable]) -> list[Any]:
+    """The values of String (as ``str``) and Binary (as ``bytes``) variables, array elements
+    included (their whole arrays are read)."""
+    out: list[Any] = [None] * len(variables)
+    for kind in ("String", "Binary"):
+        chosen = [(k, v) for k, v in enumerate(variables) if v.type == kind]
+        if not chosen:
+            continue
+        vrs: list[int] = []
+        offset: dict[int, int] = {}
+        n = 0
+        for _, v in chosen:
+            if v.vr not in offset:
+                offset[v.vr] = n
+                vrs.append(v.vr)
+                n += v.array_size
+        values = getattr(fmu, "get" + kind)(vrs, n) if fmi_version == 3 else \
+            getattr(fmu, "get" + kind)(vrs)
+        for k, v in chosen:
+            x = values[offset[v.vr] + v.element]
+            if kind == "String":
+                x = x.decode("utf-8", "replace") if isinstance(x, bytes) else str(x or "")
+            else:
+                x = bytes(x or b"")
+            out[k] = x
+    return out

@@ -11,9 +11,11 @@ Models (C sources in ``src/``, runtime ``src/glue3.c``):
 * ``StateSpace`` - der(x) = A x + B u, y = C x + D u with array variables sized by
   structural parameters;
 * ``Resource`` - reads ``resources/y.txt`` at initialization, outputs its first byte;
-* ``Countdown`` - an Int32 counter stepped down by time events; asks to terminate at 0;
+* ``Countdown`` - an Int32 counter stepped down by time events; asks to terminate at 0; the
+  counter also as a String (``left 3``) and a Binary (``03 a5``) output;
 * ``Feedthrough2`` - FMI 2.0: Real, Integer, Boolean, String and Enumeration inputs fed
-  through, with the outputs' dependencies declared (runtime ``src/glue2.c``).
+  through, with the outputs' dependencies declared, and the Integer input as a String
+  output ``Int32_text`` (runtime ``src/glue2.c``).
 
 The others are FMI 3.0 (runtime ``src/glue3.c``).
 
@@ -75,7 +77,9 @@ _COUNT = [("time", 0, "Float64", "independent", "continuous", None),
           ("start", 1, "Int32", "parameter", "fixed", "3"),
           ("counter", 2, "Int32", "output", "discrete", None),
           ("x", 3, "Float64", "output", "continuous", None),
-          ("der(x)", 4, "Float64", "local", "continuous", None, (), 'derivative="3"')]
+          ("der(x)", 4, "Float64", "local", "continuous", None, (), 'derivative="3"'),
+          ("label", 5, "String", "output", "discrete", None),
+          ("code", 6, "Binary", "output", "discrete", None)]
 
 MODELS = {
     # name: (C file, token, variables, outputs, states (vr, derivative vr), step size)
@@ -83,7 +87,8 @@ MODELS = {
                     [v[1] for v in _FEED if v[3] == "output"], [], 0.1),
     "StateSpace": ("statespace.c", "{bgm-test-statespace}", _SS, [10], [(11, 12)], 0.05),
     "Resource": ("resource.c", "{bgm-test-resource}", _RES, [1], [], 0.1),
-    "Countdown": ("countdown.c", "{bgm-test-countdown}", _COUNT, [2, 3], [(3, 4)], 0.25),
+    "Countdown": ("countdown.c", "{bgm-test-countdown}", _COUNT, [2, 3, 5, 6], [(3, 4)],
+                  0.25),
 }
 
 
@@ -102,11 +107,12 @@ _FEED2 = [("time", 0, "Real", "independent", "continuous", None),
           ("Enumeration_output", 12, "Enumeration", "output", "discrete", None),
           ("Float64_fixed_parameter", 13, "Real", "parameter", "fixed", "1"),
           ("Float64_tunable_parameter", 14, "Real", "parameter", "tunable", "2"),
-          ("Float64_parameter_sum", 15, "Real", "output", "continuous", None)]
+          ("Float64_parameter_sum", 15, "Real", "output", "continuous", None),
+          ("Int32_text", 16, "String", "output", "discrete", None)]
 
 #: FMI 2.0 models: name -> (C file, GUID, variables, output vr -> input vr it feeds from)
 MODELS2 = {"Feedthrough2": ("feedthrough2.c", "{bgm-test-feedthrough2}", _FEED2,
-                            {2: 1, 4: 3, 6: 5, 8: 7, 10: 9, 12: 11, 15: None})}
+                            {2: 1, 4: 3, 6: 5, 8: 7, 10: 9, 12: 11, 15: None, 16: 5})}
 
 
 def model_description2(name: str) -> str:

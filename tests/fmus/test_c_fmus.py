@@ -4,6 +4,7 @@ and a terminate request."""
 
 from __future__ import annotations
 
+import csv
 import shutil
 import subprocess
 import sys
@@ -21,6 +22,7 @@ from bgmodelica.cosim.fmu import read_fmu_info
 from bgmodelica.cosim.master import Master
 from bgmodelica.cosim.single import simulate_fmu
 from bgmodelica.cosim.ssp import system_from_fmus
+from bgmodelica.result import Result
 
 A = np.array([0, 1, 0, -2, -0.5, 0, 0, 0, -3.0]).reshape(3, 3)
 X0 = np.array([1.0, 0.0, 0.5])
@@ -105,7 +107,7 @@ def test_every_type_is_fed_through(c_fmus, interface):
 
 def test_typed_connections_between_fmus(c_fmus):
     """Two Feedthrough FMUs in a chain: every numeric and Boolean output drives the other's
-    input with its own type; String/Binary cannot be connected."""
+    input with its own type; a String cannot drive a Binary."""
     path = c_fmus["Feedthrough"]
     kinds = ["Float32_continuous", "Float64_continuous", "Float64_discrete", "Int8", "UInt8",
              "Int16", "UInt16", "Int32", "UInt32", "Int64", "UInt64", "Boolean", "Enumeration"]
@@ -119,8 +121,9 @@ def test_typed_connections_between_fmus(c_fmus):
         for name, v in given.items():
             assert res[f"b.{name.replace('_input', '_output')}"][-1] == v
     bad = system_from_fmus("bad", {"a": path, "b": path},
-                           [("a", "String_output", "b", "String_input")])
-    with pytest.raises(ConnectorMismatchError, match="String variables cannot be connected"):
+                           [("a", "String_output", "b", "Binary_input")])
+    with pytest.raises(ConnectorMismatchError, match="type mismatch, a.String_output is "
+                                                     "String and b.Binary_input is Binary"):
         Master(bad, allow_unconnected=True)
 
 
@@ -195,3 +198,96 @@ def test_typed_values_in_an_ssp(c_fmus, tmp_path):
     res = Master(back, allow_unconnected=True).simulate(0.2, 0.1)
     assert res["b.Int8_output"][-1] == -3 and res["b.Boolean_output"][-1] == 1
     assert res["b.UInt64_output"][-1] == 2**40
+
+
+@pytest.mark.parametrize("interface", ["me", "cs"])
+def test_strings_and_binaries_through_a_chain(c_fmus, interface, tmp_path):
+    """FMI 3.0: Countdown's String and Binary outputs change at its time events (t = 1, 2 s);
+    the master records them and passes them to a Feedthrough, whose outputs follow at the same
+    communication point; the CSV holds the text and the hex."""
+    system = system_from_fmus("text", {"c": c_fmus["Countdown"], "f": c_fmus["Feedthrough"]},
+                              [("c", "label", "f", "String_input"),
+                               ("c", "code", "f", "Binary_input")])
+    master = Master(system, interface=interface, allow_unconnected=True)
+    assert master.plan.text_sources == {("f", "String_input"): ("c", "label"),
+                                        ("f", "Binary_input"): ("c", "code")}
+    res = master.simulate(2.5, 0.25)
+    left = (3 - np.floor(res.time + 1e-9)).astype(int)
+    assert list(left[[0, 4, 8, -1]]) == [3, 2, 1, 1]
+    assert list(res["c.label"]) == [f"left {k}" for k in left]
+    assert list(res["f.String_input"]) == list(res["c.label"])
+    assert list(res["f.String_output"]) == [f"left {k}" for k in left]
+    assert list(res["f.Binary_output"]) == [bytes([k, 0xA5]) for k in left]
+    assert res["f.Int8_output"][-1] == 0                    # the numeric signals still run
+    res.to_csv(tmp_path / "text.csv")
+    with (tmp_path / "text.csv").open(newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert (rows[0]["f.String_output"], rows[0]["f.Binary_output"]) == ("left 3", "03a5")
+    assert (rows[-1]["f.String_output"], rows[-1]["f.Binary_output"]) == ("left 1", "01a5")
+    back = Result.read_csv(tmp_path / "text.csv")
+    assert back["f.String_output"][5] == "left 2" and back["f.Binary_input"][0] == "03a5"
+    assert np.array_equal(back["f.Int8_output"], res["f.Int8_output"])
+
+
+@pytest.mark.parametrize("interface", ["me", "cs"])
+def test_fmi2_strings_through_a_chain(c_fmus, interface):
+    """FMI 2.0: a.Int32_input steps from 3 to 5 at t = 1 s; its decimal text (a String
+    output) drives b.String_input (under Model Exchange set in event mode), which b feeds
+    through; a String set by name reaches a.String_output."""
+    path = c_fmus["Feedthrough2"]
+    system = system_from_fmus("text2", {"a": path, "b": path},
+                              [("a", "Int32_text", "b", "String_input")])
+    res = Master(system, interface=interface, allow_unconnected=True).simulate(
+        2.0, 0.25, parameters={"a": {"String_input": "héllo"}},
+        inputs={"a.Int32_input": ([0, 1, 1, 2], [3, 3, 5, 5])},
+        record=["b.Int32_text"])
+    expect = ["3" if t < 1 - 1e-9 else "5" for t in res.time]
+    assert list(res["a.Int32_text"]) == expect
+    assert list(res["b.String_output"]) == expect
+    assert set(res["a.String_output"]) == {"héllo"} and set(res["b.Int32_text"]) == {"0"}
+    assert set(res["b.String_input"]) == {"3", "5"}
+
+
+def test_single_fmu_through_the_cosim_command(c_fmus, tmp_path, capsys):
+    """``bgmodelica cosim MODEL.fmu``: one FMU through the master, String and Binary
+    variables set by name, recorded and written (text, hex)."""
+    from bgmodelica.cli import main
+
+    out = tmp_path / "feed.csv"
+    assert main(["cosim", str(c_fmus["Feedthrough"]), "--step", "0.5", "--stop-time", "1",
+                 "--set", "String_input=a, b", "--set", "Binary_input=00ff",
+                 "--set", "Int8_input=-5", "--record", "Float64_parameter_sum",
+                 "-o", str(out)]) == 0
+    assert "Feedthrough: Co-Simulation, 3 points" in capsys.readouterr().out
+    with out.open(newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [r["time"] for r in rows] == ["0", "0.5", "1"]
+    assert {(r["String_output"], r["Binary_output"], r["Int8_output"]) for r in rows} == {
+        ("a, b", "00ff", "-5")}
+    assert rows[-1]["Float64_parameter_sum"] == "3"
+    res = simulate_fmu(c_fmus["Countdown"], stop_time=1.5, interval=0.5, interface="me",
+                       record=["label", "x"])
+    assert list(res["label"]) == ["left 3", "left 3", "left 2", "left 2"]
+    assert list(res["code"]) == [b"\x03\xa5", b"\x03\xa5", b"\x02\xa5", b"\x02\xa5"]
+
+
+def test_model_exchange_with_forward_euler(c_fmus, tmp_path, capsys):
+    """``euler_step``: Model Exchange by forward Euler at a fixed step, x_{k+1} = (I + hA) x_k
+    exactly; the time events of Countdown still fall on their instants."""
+    h = 0.01
+    res = simulate_fmu(c_fmus["StateSpace"], stop_time=1.0, interval=0.1, interface="me",
+                       euler_step=h)
+    x, step = X0.copy(), np.eye(3) + h * A
+    for k in range(len(res.time)):
+        assert np.allclose([res[f"y[{i}]"][k] for i in (1, 2, 3)], x, rtol=1e-12, atol=1e-14)
+        x = np.linalg.matrix_power(step, 10) @ x
+    assert np.max(np.abs(res["y[3]"][-1] - (expm(A) @ X0)[2])) > 1e-3   # not the exact one
+    down = simulate_fmu(c_fmus["Countdown"], stop_time=2.5, interval=0.5, interface="me",
+                        euler_step=0.1)
+    assert list(down["counter"]) == [3, 3, 2, 2, 1, 1]
+    assert list(down["label"]) == ["left 3", "left 3", "left 2", "left 2", "left 1", "left 1"]
+    from bgmodelica.cli import main
+
+    assert main(["cosim", str(c_fmus["StateSpace"]), "--interface", "me", "--euler-step",
+                 "0", "-o", str(tmp_path / "x.csv")]) == 2
+    assert "me_euler_step must be > 0" in capsys.readouterr().err
