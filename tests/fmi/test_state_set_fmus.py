@@ -132,13 +132,14 @@ def test_reinit_of_demoted_state_is_exported():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name,version", [("Pendulum", 2), ("PendulumWall", 3)])
-def test_valgrind_state_sets_in_cosimulation(fmus, tmp_path, name, version):
-    """No leaks and no invalid reads in the state-set runtime (the switch between candidate
-    state sets, and a reinit of a demoted state, inside doStep): the C driver of
-    test_valgrind.py sets g = 1.5 m/s2 and steps 30 times 0.1 s, three times over (the
-    pendulum switches its state set at 1.24 s, PendulumWall hits its wall at 1.73 s),
-    serializing the state and asking a directional derivative."""
+@pytest.mark.parametrize("name,version,kind", [("Pendulum", 2, "cs"), ("PendulumWall", 3, "cs"),
+                                               ("Pendulum", 3, "me")])
+def test_valgrind_state_sets(fmus, tmp_path, name, version, kind):
+    """No leaks and no invalid reads in the state-set runtime, with g = 1.5 m/s2 (the
+    pendulum switches its state set at 1.24 s, PendulumWall hits its wall at 1.73 s). The C
+    drivers of test_valgrind.py: Co-Simulation steps 30 times 0.1 s, three times over,
+    serializing the state and asking a directional derivative; Model Exchange runs the FMI
+    event loop for 2.5 s twice (the switches are events that change the states' meaning)."""
     import re
     import shutil
     import subprocess
@@ -147,22 +148,29 @@ def test_valgrind_state_sets_in_cosimulation(fmus, tmp_path, name, version):
 
     if shutil.which("valgrind") is None:
         pytest.skip("valgrind is not installed")
-    fmu = fmus(name, version, "cs")
+    fmu = fmus(name, version, kind)
     with zipfile.ZipFile(fmu) as zf:
         zf.extractall(tmp_path / "fmu")
     md = read_model_description(str(fmu))
     plat = "linux64" if version == 2 else "x86_64-linux"
-    lib = tmp_path / "fmu" / "binaries" / plat / f"{md.coSimulation.modelIdentifier}.so"
+    ident = (md.coSimulation if kind == "cs" else md.modelExchange).modelIdentifier
+    lib = tmp_path / "fmu" / "binaries" / plat / f"{ident}.so"
     vrs = {v.name: v.valueReference for v in md.modelVariables}
     exe = tmp_path / "driver"
-    driver = Path(__file__).with_name("valgrind_driver.c")
+    driver = Path(__file__).with_name("valgrind_driver.c" if kind == "cs"
+                                      else "valgrind_driver_me.c")
     subprocess.run(["cc", "-g", "-O0", f"-DFMI_VERSION={version}",
                     f"-I{tmp_path / 'fmu' / 'sources'}", str(driver), "-o", str(exe), "-ldl",
                     "-lm"], check=True, capture_output=True, text=True)
-    out = md.derivatives[0].variable.valueReference          # an unknown of Step Mode
-    args = [str(exe), str(lib), md.guid, str(vrs["g"]), str(out), "0.1"]
+    if kind == "cs":
+        out = md.derivatives[0].variable.valueReference      # an unknown of Step Mode
+        args = [str(exe), str(lib), md.guid, str(vrs["g"]), str(out), "0.1"]
+    else:
+        args = [str(exe), str(lib), md.guid, str(vrs["g"]), str(vrs["x"]), "-"]
     plain = subprocess.run(args, capture_output=True, text=True, timeout=120)
     assert plain.returncode == 0, plain.stdout + plain.stderr
+    if kind == "me":
+        assert "events=2 " in plain.stdout, plain.stdout
     proc = subprocess.run(
         ["valgrind", "--tool=memcheck", "--error-exitcode=1", "--leak-check=full",
          "--errors-for-leak-kinds=definite", "--show-leak-kinds=definite", *args],
