@@ -37,7 +37,8 @@ PACKAGES = ("Modelica.Blocks.Examples", "Modelica.Electrical.Analog.Examples",
 
 #: examples of the reference set that the scan below may miss (nested or unusual layout)
 ALSO = ("Blocks.Examples.BusUsage", "Blocks.Examples.FilterWithDifferentiation",
-        "Blocks.Examples.Interaction1", "Blocks.Examples.Rectifier12pulseFFT",
+        "Blocks.Examples.Interaction1", "Blocks.Examples.Modulation",
+        "Blocks.Examples.Rectifier12pulseFFT", "Blocks.Examples.SlewRateLimiter",
         "Mechanics.Rotational.Examples.LossyGearDemo2")
 
 
