@@ -313,7 +313,9 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--rtol", type=float, default=None,
                      help="relative tolerance (default: the experiment annotation's "
                           "Tolerance of a Modelica model, else 1e-6)")
-    sim.add_argument("--atol", type=float, default=1e-8)
+    sim.add_argument("--atol", type=float, default=None,
+                     help="absolute tolerance (default 1e-8, or rtol x the smallest nominal "
+                          "value of a state when smaller)")
     sim.add_argument("--solver", choices=("idas", "cvodes", "auto"), default="auto",
                      help="integrator: auto (default: CVODES when no algebraic unknowns are "
                           "left, IDAS otherwise), IDAS (DAEs) or CVODES (explicit ODEs)")

@@ -65,7 +65,7 @@ def _located(fn: Callable) -> Callable:
 @_located
 def simulate(model: Component | CompiledModel | str, stop_time: float = 1.0,
              interval: float | None = None, params: dict[str, Any] | None = None, *,
-             start_time: float = 0.0, rtol: float = 1e-6, atol: float = 1e-8,
+             start_time: float = 0.0, rtol: float = 1e-6, atol: float | None = None,
              max_step: float | None = None, max_steps: int = 100000, solver: str = "auto",
              outputs: Sequence[str] | None = None, dynamic: bool = True,
              progress: Callable[[float], None] | None = None,
@@ -86,8 +86,11 @@ def simulate(model: Component | CompiledModel | str, stop_time: float = 1.0,
     - ``params``: overrides by dotted name of parameters, model inputs (held constant) or
       start values of variables; a value may carry a unit (``{"R.R": "2 kOhm"}``), converted
       to the declared unit.
-    - ``rtol``, ``atol``: integrator tolerances; ``max_step`` [s]: largest internal step;
-      ``max_steps``: most internal steps per output interval.
+    - ``rtol``, ``atol``: integrator tolerances (``atol`` by default 1e-8, or ``rtol`` times
+      the smallest ``nominal`` a state declares when that is smaller: a relative angle of
+      nominal 1e-4 rad is then resolved as a Modelica tool resolves it; ``result.meta["atol"]``
+      says which); ``max_step`` [s]: largest internal step; ``max_steps``: most internal
+      steps per output interval.
     - ``solver``: ``"auto"`` (default: CVODES when the reduced model is an explicit ODE, no
       algebraic unknowns left; IDAS otherwise), ``"idas"`` or ``"cvodes"`` (ODE models only);
       ``result.meta["solver"]`` says which ran and ``meta["solver_choice"]`` whether it was
@@ -134,6 +137,8 @@ def simulate(model: Component | CompiledModel | str, stop_time: float = 1.0,
     rtol, atol, max_step = opt["rtol"], opt["atol"], opt["max_step"]
     compiled = model if isinstance(model, CompiledModel) else compile(model, units=units)
     dae = compiled.dae
+    if atol is None:
+        atol = default_atol(compiled, rtol)
     choice = "auto" if solver == "auto" else "given"
     if solver == "auto":
         solver = "cvodes" if dae.z.numel() == 0 else "idas"
@@ -181,7 +186,7 @@ def simulate(model: Component | CompiledModel | str, stop_time: float = 1.0,
                 check_result(err.result, dae, p)
             raise
         check_result(result, dae, p)
-        result.meta.update(solver_meta)
+        result.meta.update(solver_meta, rtol=rtol, atol=atol)
         check_asserts(compiled, result)
         return result
     init = initialize(dae, p, start_time)
@@ -205,6 +210,7 @@ def simulate(model: Component | CompiledModel | str, stop_time: float = 1.0,
     meta = {"model": compiled.name, "compile_seconds": compiled.compile_time,
             "run_seconds": run,
             "timings": dict(compiled.timings), "solver": solver, "solver_choice": choice,
+            "rtol": rtol, "atol": atol,
             **solver_meta, "stats": stats,
             "states": list(dae.state_names), "init_notes": init.notes}
     aliases = _kept_aliases(dae, flat, obs_idx, names)
@@ -220,6 +226,21 @@ def simulate(model: Component | CompiledModel | str, stop_time: float = 1.0,
             t_reached, result)
     check_asserts(compiled, result)
     return result
+
+
+def default_atol(compiled: CompiledModel, rtol: float) -> float:
+    """The absolute tolerance when none is given: 1e-8, or ``rtol`` times the smallest
+    ``nominal`` declared by a state when that is smaller (kept in ``dae.cache``)."""
+    dae = compiled.dae
+    key = ("nominal atol", rtol)
+    if key not in dae.cache:
+        states = set(dae.state_names)
+        nominal = [abs(float(getattr(v.decl, "nominal", 1.0) or 1.0))
+                   for v in getattr(compiled.declarations, "variables", ())
+                   if v.name in states] if states else []
+        smallest = min((n for n in nominal if n > 0), default=1.0)
+        dae.cache[key] = min(1e-8, rtol * smallest)
+    return dae.cache[key]
 
 
 def _units_by_name(dae: CasadiDAE, flat: Any) -> dict[str, str]:

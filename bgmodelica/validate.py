@@ -86,7 +86,7 @@ def _real(name: str, value: Any, *, allow_none: bool = False) -> float | None:
 
 
 def check_run_options(*, start_time: Any = 0.0, stop_time: Any = 1.0, interval: Any = None,
-                      rtol: Any = 1e-6, atol: Any = 1e-8, max_step: Any = None,
+                      rtol: Any = 1e-6, atol: Any = None, max_step: Any = None,
                       max_steps: Any = 100000, solver: Any = "auto") -> dict[str, Any]:
     """Validate the options of :func:`bgmodelica.simulate`; returns them as floats/ints.
 
@@ -107,8 +107,8 @@ def check_run_options(*, start_time: Any = 0.0, stop_time: Any = 1.0, interval: 
     r = _real("rtol", rtol)
     if not 0 < r < 1:
         raise OptionError(f"{_option('rtol')} = {r:g} must be in (0, 1)")
-    a = _real("atol", atol)
-    if a <= 0:
+    a = _real("atol", atol, allow_none=True)
+    if a is not None and a <= 0:
         raise OptionError(f"{_option('atol')} = {a:g} must be positive")
     ms = _real("max_step", max_step, allow_none=True)
     if ms is not None and ms <= 0:
