@@ -55,11 +55,63 @@ def reduce_index(model: FlatModel | ReducedModel,
 
     Given a :class:`ReducedModel` (whose differentiated equations are already present) it
     differentiates nothing more: reduction is idempotent.
+
+    A variable that declares ``StateSelect.prefer`` (or ``always``) but appears only as a
+    derivative in disguise (``v_rel = der(s_rel)``, the relative speed of the MSL's springs
+    and dampers) is no state candidate on its own: no equation holds ``der(v_rel)``. As
+    Modelica tools do, the reduction is then tried again with ``der(v_rel)`` made available
+    (the equations that need it are differentiated); that selection is kept when it makes
+    such a variable a state, in place of one of lower priority. It matters beyond accuracy:
+    a ``reinit`` of a state keeps the other states, so which ones they are is semantics.
     """
-    links: list[int] = []
     if isinstance(model, ReducedModel):
-        links = list(model.graph.eq_derivative)
-        model = model.model
+        return _reduce(model.model, list(model.graph.eq_derivative), select)
+    plain = _reduce(model, [], select)
+    wanted = [v for v in preferred_derivative_aliases(model) if v not in plain.states]
+    if not wanted:
+        return plain
+    try:
+        augmented = _reduce(_with_derivatives(model, wanted), [], select)
+    except (UnbalancedModelError, EquationError, StateSelectError):
+        return plain
+    return augmented if any(v in augmented.states for v in wanted) else plain
+
+
+def preferred_derivative_aliases(model: FlatModel) -> list[int]:
+    """Variables declaring ``StateSelect.prefer`` or ``always`` that are not differentiated
+    and are set equal to a derivative by an equation of two unknowns (``v = der(s)``)."""
+    variables = model.variables
+    out = []
+    for row in model_incidence(model):
+        if len(row) != 2:
+            continue
+        a, b = row
+        for v, d in ((a, b), (b, a)):
+            var = variables[v]
+            if var.der < 0 and var.der_of < 0 and variables[d].der_of >= 0 \
+                    and int(getattr(var.decl, "state_select", 0)) >= 1 and v not in out:
+                out.append(v)
+    return out
+
+
+def _with_derivatives(model: FlatModel, wanted: list[int]) -> FlatModel:
+    """``model`` with a derivative variable added for each of ``wanted``."""
+    variables = list(model.variables)
+    for v in wanted:
+        var = variables[v]
+        variables[v] = replace(var, der=len(variables))
+        name = f"der({var.name})"
+        variables.append(FlatVariable(name, ca.SX.sym(name), Variable(
+            unit=derivative_unit(var.decl.unit), nominal=getattr(var.decl, "nominal", 1.0)),
+            var.component, der_of=v))
+    out = FlatModel(model.name, variables, model.parameters, model.inputs, model.equations,
+                    model.aliases, model.discretes, model.hybrid)
+    out.initial_equations = model.initial_equations
+    out.asserts = model.asserts
+    return out
+
+
+def _reduce(model: FlatModel, links: list[int], select: Selector | None) -> ReducedModel:
     eq_vars = [list(row) for row in model_incidence(model)]
     graph = EquationGraph(eq_vars, len(model.variables), [v.der for v in model.variables],
                           links)
