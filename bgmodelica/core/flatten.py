@@ -292,9 +292,10 @@ class _Flattener(ConnectionLowering):
                         add_variable(fv)
                         below = len(variables) - 1
         if self.draft is not None:
+            named = self.full                     # once: the hidden symbols add to the list
             for k, sym in enumerate(self.draft.hidden()):
                 if sym.pre_of is not None:
-                    owner = self.full.get(id(sym.pre_of))
+                    owner = named.get(id(sym.pre_of))
                     if owner is None:
                         raise DeclarationError(f"pre({sym.pre_of.name}) refers to a variable "
                                                "that is not part of the model")
@@ -304,6 +305,7 @@ class _Flattener(ConnectionLowering):
                 self.slot[id(sym)] = len(discretes)
                 fv = FlatVariable(name, None, sym.decl, "")
                 symbols.append((sym, fv))
+                named[id(sym)] = name
                 discretes.append(fv)
         self.entries = (var_entries, par_entries)
         return variables, parameters, inputs, discretes, symbols

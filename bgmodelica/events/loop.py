@@ -109,6 +109,9 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin, MixedSystemMixin, Segm
                                  "must be a positive finite number", 0.0)
         self.tables = [(t, nb + t.c0, nb + t.c1) for t in hyb.tables]
         self.cond_pre = np.zeros(0)
+        #: per branch: the p indices its assignments write and their positions in ``assign``
+        self._assigns = [(np.array([k for k, _ in a], dtype=np.int64),
+                          np.array([q for _, q in a], dtype=np.int64)) for a in self.fn.assign_of]
         #: per relation: how far past zero its indicator must go to change it between events
         self.hysteresis = np.zeros(len(self.fn.relations))
         nz = dae.z.numel()
@@ -343,10 +346,12 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin, MixedSystemMixin, Segm
                 assign, reinit, pre_src = out[3], out[4], out[5]
             new_x, fixed = np.array(x, dtype=float), []
             for b in fired:
-                for pidx, pos in fn.assign_of[b]:
-                    if self.p[pidx] != assign[pos]:
-                        changing.append(dae.discretes[pidx - nb].name)
-                    self.p[pidx] = assign[pos]
+                pidx, pos = self._assigns[b]
+                if pidx.size:                  # at once: a sampled buffer has thousands
+                    value = assign[pos]
+                    moved = np.flatnonzero(self.p[pidx] != value)
+                    changing += [dae.discretes[k - nb].name for k in pidx[moved[:4]]]
+                    self.p[pidx] = value
                 for name, pos in fn.reinit_of[b]:
                     rep, sign = dae.aliases.get(name, (name, 1.0))
                     value = sign * reinit[pos]
