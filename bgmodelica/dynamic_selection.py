@@ -19,6 +19,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
+from .backends.casadi_dae import resolved_bindings
 from .compiler import CompiledModel, recompile
 from .core.variables import TIME
 from .structure import dummy_derivatives
@@ -43,13 +44,10 @@ class StateSelector:
         jac = ca.jacobian(res, syms)
         bound = [p for p in model.parameters if isinstance(p.decl.value, ca.SX)]
         if bound:
-            _, (jac,) = ca.substitute_inplace(
-                [ca.vertcat(*[p.sx for p in bound])],
-                [ca.vertcat(*[ca.SX(p.decl.value) for p in bound])], [jac], False)
-        free = [p for p in model.parameters if not isinstance(p.decl.value, ca.SX)]
-        p_vec = ca.vertcat(*[p.sx for p in free], *[u.sx for u in model.inputs],
-                           *[d.sx for d in model.discretes])
-        self._jac = ca.Function("selection_jacobian", [syms, p_vec, TIME.sx], [jac])
+            jac = ca.substitute(jac, *resolved_bindings(bound))
+        # the DAE's own parameter vector (p_default's layout: parameters, inputs, then every
+        # discrete slot, relations and pre() values of a hybrid model included)
+        self._jac = ca.Function("selection_jacobian", [syms, self.base.dae.p, TIME.sx], [jac])
         self.variants[self.key(red.dummies)] = self.base
         self.priority = red.priority
 

@@ -82,12 +82,7 @@ class CasadiDAE:
             if "bound_values" not in self.cache:
                 free = ca.vertcat(*[q.sx for q in self.parameters]) if self.parameters \
                     else ca.SX(0, 1)
-                expr = ca.vertcat(*[ca.SX(q.decl.value) for q in self.bound])
-                for _ in range(len(self.bound)):       # bindings may chain
-                    syms = [q.sx for q in self.bound]
-                    if not ca.depends_on(expr, ca.vertcat(*syms)):
-                        break
-                    expr = ca.substitute(expr, ca.vertcat(*syms), expr)
+                _, expr = resolved_bindings(self.bound)
                 try:
                     self.cache["bound_values"] = ca.Function("bound", [free], [expr])
                 except RuntimeError:      # bound to something else than free parameters
@@ -164,6 +159,19 @@ def _number(name: str, value: object, unit: str | None = None) -> float:
     return out
 
 
+def resolved_bindings(bound: list[FlatVariable]) -> tuple[ca.SX, ca.SX]:
+    """The symbols of the parameters ``bound`` to expressions and those expressions in terms
+    of free parameters only: bindings may chain in any order (``L1 = L1sigma + M*n`` before
+    ``M = Lm1/n``), so they are substituted into each other until none is left."""
+    syms = ca.vertcat(*[q.sx for q in bound])
+    values = ca.vertcat(*[ca.SX(q.decl.value) for q in bound])
+    for _ in range(len(bound)):
+        if not ca.depends_on(values, syms):
+            break
+        values = ca.substitute(values, syms, values)
+    return syms, values
+
+
 def build_dae(sorted_dae: SortedDAE) -> CasadiDAE:
     """Assemble the CasADi DAE of a sorted model."""
     model = sorted_dae.model
@@ -190,9 +198,8 @@ def build_dae(sorted_dae: SortedDAE) -> CasadiDAE:
                                               [sorted_dae.stacked_definitions()],
                                               [targets], False)
     if bound:
-        bsym = ca.vertcat(*[p.sx for p in bound])
-        bdef = ca.vertcat(*[ca.SX(p.decl.value) for p in bound])
-        _, (targets,) = ca.substitute_inplace([bsym], [bdef], [targets], False)
+        bsym, bdef = resolved_bindings(bound)
+        targets = ca.substitute(targets, bsym, bdef)
     n_x, n_r = len(states), len(sorted_dae.residuals)
     if targets.numel() <= CSE_UP_TO:
         targets = ca.cse(targets)

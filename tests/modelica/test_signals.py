@@ -239,3 +239,24 @@ end Top;
 """, "Top")
     r = bg.simulate(model, stop_time=0.1, interval=0.1)
     assert r["t.x"][-1] == 1.0 and r["y"][-1] == 1.0
+
+
+def test_parameter_bindings_chained_in_any_order():
+    """``p2 = 2*p3`` before ``p3 = p1/5`` before... with ``p1 = 10*k``: each binding resolves
+    to the free parameters whatever the declaration order (a chain like a transformer's
+    ``L1 = L1sigma + M*n`` with ``M = Lm1/n``), also with events in the model."""
+    model = load_modelica_text("""
+model Chain
+  parameter Real k = 1;
+  parameter Real p1 = 10*k;
+  parameter Real p2 = 2*p3;
+  parameter Real p3 = p1/5;
+  Real x(start = 0, fixed = true);
+  Real y = if time < 0.5 then 0 else 1;
+equation
+  der(x) = p2;
+end Chain;
+""", "Chain")
+    r = bg.simulate(model, stop_time=1.0, interval=0.5, params={"k": 2.0})
+    np.testing.assert_allclose(r["x"][-1], 8.0, rtol=1e-9)
+    assert r.parameters["p2"] == 8.0
