@@ -24,8 +24,8 @@ from pathlib import Path
 from . import ast as A
 
 FORMAT = 1
-_SOURCES = ("grammar.lark", "parser.py", "expression_rules.py", "statement_rules.py",
-            "ast.py", "ast_cache.py")
+_SOURCES = ("grammar.lark", "parser.py", "parse_values.py", "expression_rules.py",
+            "statement_rules.py", "ast.py", "ast_cache.py")
 
 
 @lru_cache(maxsize=1)

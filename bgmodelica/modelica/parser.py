@@ -25,6 +25,10 @@ from . import ast as A
 from . import ast_cache
 from .errors import ModelicaError, ModelicaSyntaxError
 from .expression_rules import first_pos, ident_text, token_pos
+from .parse_values import ClassMod as _ClassMod
+from .parse_values import Name as _Name
+from .parse_values import Prefixes as _Prefixes
+from .parse_values import Section as _Section
 from .statement_rules import StatementRules
 
 _GRAMMAR = Path(__file__).with_name("grammar.lark")
@@ -34,29 +38,6 @@ UNSUPPORTED_WORDS = {
     "Clock": "synchronous (clocked) language elements",
     "subSample": "synchronous (clocked) language elements",
 }
-
-
-class _ClassMod(tuple):
-    """The argument list of a class modification (distinguished from other tuples); ``pos``
-    is its opening parenthesis."""
-
-    pos: A.Pos
-
-
-class _Section(tuple):
-    """``(kind, items)`` of a composition."""
-
-
-class _Prefixes(tuple):
-    """``(partial, purity, kind)`` of a class definition; ``pos`` its first keyword."""
-
-    pos: A.Pos
-
-
-class _Name(str):
-    """A dotted name with the position ``pos`` of its first identifier."""
-
-    pos: A.Pos
 
 
 _PURITY = {"PURE": "pure", "IMPURE": "impure"}
