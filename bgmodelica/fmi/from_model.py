@@ -38,6 +38,22 @@ from .export import export_fmu
 from .spec import FmuSpec, FmuSpecError, ScalarVariable
 
 
+def parameters_and_inputs(dae, p_all) -> tuple[list[ScalarVariable], list[ScalarVariable]]:
+    """The FMU's parameters and inputs, with the values of ``p_all`` (parameters first)."""
+    n_par = len(dae.parameters)
+
+    def var(q, value: float, kind: str) -> ScalarVariable:
+        return ScalarVariable(q.name, float(value), q.decl.unit or "",
+                              q.decl.description or "", *_bounds(q.decl, q.name, kind))
+    return ([var(q, p_all[k], "parameter") for k, q in enumerate(dae.parameters)],
+            [var(q, p_all[n_par + k], "input") for k, q in enumerate(dae.inputs)])
+
+
+def model_identifier(name: str) -> str:
+    """``name`` as a C identifier (other characters become ``_``)."""
+    return "".join(c if c.isalnum() or c == "_" else "_" for c in name) or "model"
+
+
 def _bounds(decl: object, name: str, kind: str) -> tuple[float | None, float | None]:
     """``(min, max)`` of a declaration as floats (None: not declared or infinite)."""
     out: list[float | None] = []
@@ -192,13 +208,8 @@ def fmu_spec(model: Component | CompiledModel, *, stop_time: float = 1.0,
     locals_ = [scalar(n, y0[n_out + k]) for k, n in enumerate(local_names)]
     locals_ += [alias(a, y0[n_out + len(local_names) + k]) for k, a in enumerate(alias_names)]
     state_vars = [scalar(n, x_init[k], "state") for k, n in enumerate(dae.state_names)]
-    params = [ScalarVariable(q.name, float(p_all[k]), q.decl.unit or "",
-                             q.decl.description or "", *_bounds(q.decl, q.name, "parameter"))
-              for k, q in enumerate(dae.parameters)]
-    inputs = [ScalarVariable(q.name, float(p_all[n_par + k]), q.decl.unit or "",
-                             q.decl.description or "", *_bounds(q.decl, q.name, "input"))
-              for k, q in enumerate(dae.inputs)]
-    name = "".join(c if c.isalnum() or c == "_" else "_" for c in compiled.name) or "model"
+    params, inputs = parameters_and_inputs(dae, p_all)
+    name = model_identifier(compiled.name)
     hyb_spec = None
     if hybrid:
         from .hybrid import build_hybrid

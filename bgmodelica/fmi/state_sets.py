@@ -293,7 +293,7 @@ def state_set_spec(compiled: CompiledModel, *, stop_time: float = 1.0,
     """The :class:`FmuSpec` of a model that needs dynamic state selection (see the module
     docstring): every model variable an output or a local, the state slots as states."""
     from ..core.variables import KIND_OUTPUT
-    from .from_model import _bounds
+    from .from_model import _bounds, model_identifier, parameters_and_inputs
 
     flat = compiled.reduced.model
     dae = compiled.dae
@@ -324,13 +324,8 @@ def state_set_spec(compiled: CompiledModel, *, stop_time: float = 1.0,
 
     all_names = names + aliases
     values = dict(zip(all_names, y0, strict=True))
-    params = [ScalarVariable(q.name, float(p_all[k]), q.decl.unit or "",
-                             q.decl.description or "", *_bounds(q.decl, q.name, "parameter"))
-              for k, q in enumerate(dae.parameters)]
-    inputs = [ScalarVariable(q.name, float(p_all[n_par + k]), q.decl.unit or "",
-                             q.decl.description or "", *_bounds(q.decl, q.name, "input"))
-              for k, q in enumerate(dae.inputs)]
-    name = "".join(c if c.isalnum() or c == "_" else "_" for c in compiled.name) or "model"
+    params, inputs = parameters_and_inputs(dae, p_all)
+    name = model_identifier(compiled.name)
     return FmuSpec(model_name=name, description=f"{compiled.name} (bgmodelica)",
                    states=exp.states(x0), inputs=inputs, parameters=params,
                    outputs=[scalar(n, values[n]) for n in outputs],
