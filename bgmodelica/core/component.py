@@ -30,7 +30,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import ConnectError, DeclarationError, DuplicateNameError
-from ..structure.graph import gc_paused
+from ..structure.collector import collect_if_due, gc_paused
 from .array_marks import mark_leaves
 from .arrays import (
     ArrayEquation,
@@ -64,6 +64,7 @@ def _gc_paused_init(init: Callable[..., None]) -> Callable[..., None]:
     def paused(self: Any, *args: Any, **kwargs: Any) -> None:
         if not gc.isenabled():
             return init(self, *args, **kwargs)
+        collect_if_due()                   # the models built and dropped before this one
         with gc_paused():
             return init(self, *args, **kwargs)
     return paused

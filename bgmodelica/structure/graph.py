@@ -2,32 +2,12 @@
 
 from __future__ import annotations
 
-import gc
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from itertools import chain
 
 import numpy as np
 
-
-@contextmanager
-def gc_paused() -> Iterator[None]:
-    """Pause the cyclic garbage collector (the graph algorithms allocate many small acyclic
-    lists, which makes it trigger often for nothing). Usable as a decorator.
-
-    The objects made meanwhile are left to the collector's usual policy afterwards. Moving
-    them straight to the oldest generation (``gc.freeze(); gc.unfreeze()``) would save two
-    scans of them, but it hides them from the count that triggers full collections: a model
-    tree is cyclic (symbols and their owners), and models built and dropped in a loop then
-    piled up uncollected."""
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if enabled:
-            gc.enable()
+from .collector import gc_paused as gc_paused  # (its home before collector.py)
 
 
 @dataclass

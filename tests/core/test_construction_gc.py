@@ -75,9 +75,10 @@ def _collect_all() -> None:
 def test_models_built_and_dropped_in_a_loop_are_collected():
     """A model tree is cyclic (symbols and their owners): the collector must still see the
     objects of dropped models. Of fifteen 1500-section ladders built and dropped, a few stay
-    alive until the next full collection; moving a large model's objects straight to the
-    oldest generation (to spare the young collections a scan of them) hides them from the
-    count that triggers full collections, and then all fifteen were still alive."""
+    alive until the next full collection. A large model's objects go straight to the oldest
+    generation (sparing the young collections a scan of them), which hides them from the
+    count that triggers full collections: without the count kept by
+    :mod:`bgmodelica.structure.collector`, all fifteen were still alive."""
     from library.electrical import Resistor
 
     _collect_all()
@@ -86,3 +87,11 @@ def test_models_built_and_dropped_in_a_loop_are_collected():
         del model
     alive = sum(1 for o in gc.get_objects() if type(o) is Resistor)
     assert alive <= 8 * 1500
+
+
+def test_a_large_model_goes_straight_to_the_oldest_generation():
+    """The objects of a large model are not left for a young collection to scan."""
+    _collect_all()
+    model = RCLadder(1500)
+    assert gc.get_count()[0] < 1000
+    assert any(o is model for o in gc.get_objects(generation=2))
