@@ -90,14 +90,13 @@ def _compile_blocks(col: Any, lap: Any) -> Any:
     """The :class:`~bgmodelica.backends.casadi_dae.CasadiDAE` of a collected model, or why
     its equations do not solve explicitly block by block."""
     col.equations = group_scalars(col.equations)
-    low = Lowered(col)
     aliases = find_aliases(col)
     if isinstance(aliases, str):
         return aliases
+    low = Lowered(col, aliases)
     n = len(col.order)
     kept = np.ones(n, dtype=bool)
     if aliases is not None:
-        low.eliminate(aliases.dropped, aliases.target, aliases.sign)
         kept[:] = False
         kept[aliases.keep] = True
     lap("lowering")

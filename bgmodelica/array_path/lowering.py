@@ -20,6 +20,7 @@ from ..core.arrays import ArrayExpr
 from ..core.expr import Expr, apply_op, lower_group, lower_tree
 from ..core.flatten import _count
 from ..core.flatten_arrays import _rows
+from .aliases import Aliases
 from .collect import Collected
 from .connections import LinearRows
 from .scalars import ScalarGroup
@@ -28,11 +29,21 @@ from .scalars import ScalarGroup
 class Lowered:
     """The blocks of a collected model: ``blocks[k]`` is the MX residual column of equation
     ``k`` (``sizes[k]`` scalar equations); ``rows``/``cols`` the incidence pairs, rows
-    numbered over all blocks, columns over ``x`` (variables and derivatives)."""
+    numbered over all blocks, columns over ``x`` (variables and derivatives).
 
-    def __init__(self, col: Collected) -> None:
+    With ``aliases``, every column is read as its representative (``sign * x[target]``)
+    as it is lowered, and the alias equations are left out: the blocks never read an
+    eliminated column, and no block carries a map of the whole column."""
+
+    def __init__(self, col: Collected, aliases: Aliases | None = None) -> None:
         n, n_p = len(col.order), len(col.params)
         self.n, self.n_p = n, n_p
+        total = n + n_p + 1                    # columns of ``all``: x, p, t
+        self.target = np.arange(total, dtype=np.int64)
+        self.sign = np.ones(total)
+        if aliases is not None:
+            self.target[:n] = aliases.target
+            self.sign[:n] = aliases.sign
         self.x, self.p, self.t = ca.MX.sym("x", n), ca.MX.sym("p", n_p), ca.MX.sym("t")
         self.all = ca.vertcat(self.x, self.p, self.t)
         self.pos, self.memo = col.pos, col.memo
@@ -61,6 +72,8 @@ class Lowered:
             start += size
         self.rows = np.concatenate(rows) if rows else np.zeros(0, dtype=np.int64)
         self.cols = np.concatenate(cols) if cols else np.zeros(0, dtype=np.int64)
+        if aliases is not None:
+            self._drop(aliases.dropped)
 
     def _add(self, res: Any, size: int) -> None:
         """A block: the residual ``res`` as an MX column of ``size`` rows."""
@@ -74,12 +87,16 @@ class Lowered:
     def _linear(self, eq: LinearRows, start: int, rows: list, cols: list) -> None:
         """Linear rows (connection sets) as one sparse matrix product."""
         total = self.n + self.n_p + 1
-        matrix = ca.DM.triplet(eq.rows.tolist(), eq.cols.tolist(), ca.DM(eq.coefs.tolist()),
-                               eq.size, total)
+        read = self.target[eq.cols]
+        entry, at = np.unique(eq.rows * total + read, return_inverse=True)
+        coefs = np.zeros(entry.size)                 # a column read twice: its terms summed
+        np.add.at(coefs, at, eq.coefs * self.sign[eq.cols])
+        matrix = ca.DM.triplet((entry // total).tolist(), (entry % total).tolist(),
+                               ca.DM(coefs.tolist()), eq.size, total)
         self.blocks.append(ca.mtimes(matrix, self.all))
         self.sizes.append(eq.size)
         rows.append(eq.rows + start)
-        cols.append(eq.cols)
+        cols.append(read)
 
     def _group(self, group: ScalarGroup, start: int, rows: list, cols: list) -> None:
         """Scalar equations of one shape as one block on their leaves' columns."""
@@ -89,6 +106,7 @@ class Lowered:
         idx = np.fromiter(map(self.pos.of, flat), np.int64,      # (of: without filling the
                           size * width).reshape(size, width)      # dict of a leaf model)
         leaf_vecs = [self._take(idx[:, j]) for j in range(idx.shape[1])]
+        idx = self.target[idx]
         const_vecs: list[Any] = []
         for j in range(len(group.consts[0])):
             values = [c[j] for c in group.consts]
@@ -100,11 +118,8 @@ class Lowered:
         rows.append(np.repeat(np.arange(start, start + size, dtype=np.int64), idx.shape[1]))
         cols.append(idx.ravel())
 
-    def eliminate(self, dropped: dict[int, np.ndarray], target: np.ndarray,
-                  sign: np.ndarray) -> None:
-        """Drop the alias equations (``dropped``: block -> which of its rows) and read every
-        column ``k`` of ``x`` as ``sign[k] * x[target[k]]`` in the others (the eliminated
-        aliases)."""
+    def _drop(self, dropped: dict[int, np.ndarray]) -> None:
+        """Drop the alias equations (``dropped``: block -> which of its rows)."""
         starts = np.concatenate([[0], np.cumsum(self.sizes)]).astype(np.int64)
         row_kept = np.ones(int(starts[-1]), dtype=bool)
         blocks, sizes = [], []
@@ -121,15 +136,8 @@ class Lowered:
                 sizes.append(int(keep.size))
         renumber = np.cumsum(row_kept) - 1
         used = row_kept[self.rows]
-        cols = self.cols[used]
-        inside = cols < self.n
-        cols[inside] = target[cols[inside]]
-        self.rows, self.cols = renumber[self.rows[used]], cols
-        read = self.x[target.tolist()]
-        if (sign != 1.0).any():
-            read = read * ca.DM(sign)
-        self.blocks = [ca.substitute(block, self.x, read) for block in blocks]
-        self.sizes = sizes
+        self.rows, self.cols = renumber[self.rows[used]], self.cols[used]
+        self.blocks, self.sizes = blocks, sizes
 
     def lower(self, x: Any, want: tuple[int, ...]) -> tuple[Any, list[np.ndarray]]:
         """``x`` as an MX column of shape ``want`` (C order) and, per operand array, the
@@ -137,7 +145,7 @@ class Lowered:
         if isinstance(x, ArrayExpr):
             if x.node is None:
                 idx = np.asarray(_rows(x.items, self.pos, self.memo), dtype=np.int64)
-                col, maps = self._take(idx), [idx]
+                col, maps = self._take(idx), [self.target[idx]]
             else:
                 op, args = x.node
                 parts = [self.lower(a, x.shape) for a in args]
@@ -159,19 +167,29 @@ class Lowered:
         return float(x), []
 
     def _take(self, idx: np.ndarray) -> ca.MX:
-        """The columns ``idx``: a slice when they are evenly spaced (most are: slices of
-        declared arrays), a list of indices otherwise."""
-        if idx.size > 1:
-            step = int(idx[1] - idx[0])
-            if step > 0 and (np.diff(idx) == step).all():
-                return self.all[int(idx[0]):int(idx[-1]) + 1:step]
-        return self.all[idx.tolist()]
+        """The columns ``idx`` as read (each its representative, signed): a slice when
+        they are evenly spaced (most are: slices of declared arrays), a list of indices
+        otherwise."""
+        sign = self.sign[idx]
+        idx = self.target[idx]
+        step = int(idx[1] - idx[0]) if idx.size > 1 else 0
+        if step > 0 and (np.diff(idx) == step).all():
+            read = self.all[int(idx[0]):int(idx[-1]) + 1:step]
+        else:
+            read = self.all[idx.tolist()]
+        if (sign == 1.0).all():
+            return read
+        if (sign == sign[0]).all():
+            return float(sign[0]) * read
+        return read * ca.DM(sign)
 
     def _scalar(self, e: Any, leaves: list[int]) -> Any:
         """A scalar expression tree as MX (its leaves' columns appended to ``leaves``)."""
         def leaf(sym: Any) -> ca.MX:
             k = self.pos.of(sym)
-            leaves.append(k)
-            return self.all[k]
+            read = int(self.target[k])
+            leaves.append(read)
+            sign = float(self.sign[k])
+            return self.all[read] if sign == 1.0 else sign * self.all[read]
 
         return lower_tree(e, leaf)
