@@ -236,13 +236,17 @@ def explain(dae: Any, values: dict[str, float], p: np.ndarray, t: float) -> str:
 
 # -- checks --------------------------------------------------------------------------------------
 
-def _point_function(dae: Any) -> ca.Function:
+def _point_function(dae: Any) -> Any:
+    """``(t, x, z, p) -> (ode, alg, observed)``, dense, with bound buffers
+    (:class:`~bgmodelica.events.fast.Fast`, made once per model)."""
+    from .events.fast import Fast
+
     key = ("bgm_point", dae.x.numel(), dae.z.numel(), dae.p.numel())
     f = dae.cache.get(key)
     if f is None:
-        f = ca.Function("bgm_point", [dae.t, dae.x, dae.z, dae.p],
-                        [dae.ode, dae.alg, dae.observed])
-        dae.cache[key] = f
+        f = dae.cache[key] = Fast(ca.Function(
+            "bgm_point", [dae.t, dae.x, dae.z, dae.p],
+            [ca.densify(e) for e in (dae.ode, dae.alg, dae.observed)]))
     return f
 
 
@@ -253,9 +257,9 @@ def check_initial_point(dae: Any, x0: Any, z0: Any, p: Any, t0: float) -> None:
     x0 = np.asarray(x0, dtype=float).reshape(-1)
     z0 = np.asarray(z0, dtype=float).reshape(-1)
     with np.errstate(all="ignore"):
-        ode, alg, obs = (np.asarray(v, dtype=float).ravel()
-                         for v in f(t0, x0 if dae.x.numel() else np.zeros(0),
-                                    z0 if dae.z.numel() else np.zeros(0), p))
+        ode, alg, obs = (v.copy() for v in f(t0, x0 if dae.x.numel() else np.zeros(0),
+                                            z0 if dae.z.numel() else np.zeros(0),
+                                            np.asarray(p, dtype=float).ravel()))
     if np.all(np.isfinite(ode)) and np.all(np.isfinite(alg)) and np.all(np.isfinite(obs)):
         _check_residuals(dae, obs, p, t0)
         return
@@ -287,16 +291,19 @@ def _check_residuals(dae: Any, obs: np.ndarray, p: Any, t0: float) -> None:
     layout = _Layout.of(dae, len(p))
     f = dae.cache.get("bgm_residuals")
     if f is None:
+        from .events.fast import Fast
+
         known = {s.element_hash() for s in layout.syms}
         rows = [k for k, e in enumerate(srt.model.equations)
                 if all(s.element_hash() in known for s in ca.symvar(e.residual))]
         out = ca.vertcat(*[srt.model.equations[k].residual for k in rows]) if rows \
             else ca.SX(0, 1)
-        f = dae.cache["bgm_residuals"] = (ca.Function("bgm_res", [layout.X], [out]), rows)
+        f = dae.cache["bgm_residuals"] = (
+            Fast(ca.Function("bgm_res", [layout.X], [ca.densify(out)])), rows)
     fn, rows = f
     vals = layout.observed_values(dae, obs, p, t0)
     with np.errstate(all="ignore"):
-        res = np.asarray(fn(vals), dtype=float).ravel()
+        res = fn(vals)[0]
     if np.all(np.isfinite(res)):
         return
     pt = _Point(dae, {}, p, t0, vals)

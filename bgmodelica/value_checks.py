@@ -47,8 +47,6 @@ def check_values(dae: Any, p: np.ndarray, flat: Any = None) -> None:
     expressions of others and the declarations of the variables. The parameters and inputs
     are checked in numpy against bounds kept in ``dae.cache``; the start values, fixed when
     the model was compiled, are checked once per model."""
-    import casadi as ca
-
     p = np.asarray(p, dtype=float)
     n_par, n_in = len(dae.parameters), len(dae.inputs)
     lo, hi = _value_bounds(dae)
@@ -66,13 +64,17 @@ def check_values(dae: Any, p: np.ndarray, flat: Any = None) -> None:
         raise ParameterError(f"discrete variable {bad_discrete[0]} starts at a non-finite "
                              "value")
     if flat is not None:
-        bound = [q for q in flat.parameters if isinstance(q.decl.value, ca.SX)]
+        bound, lo, hi = _bound_parameters(dae, flat)
         if bound:
             values = _bound_values(dae, bound, p)
-            for q, v in zip(bound, values, strict=True):
-                if v is not None:
+            v = np.array([math.nan if x is None else x for x in values], dtype=float)
+            with np.errstate(invalid="ignore"):
+                bad = ~np.isfinite(v) | (v < lo) | (v > hi)
+            for k in np.flatnonzero(bad).tolist():     # the first one raises
+                q = bound[k]
+                if values[k] is not None:
                     comp = f", declared in {q.component}" if q.component else ""
-                    _check_one("parameter", q.name, v, q.decl,
+                    _check_one("parameter", q.name, values[k], q.decl,
                                f" (bound to other parameters{comp})")
     # a DAE copied with other start values (dataclasses.replace) shares the cache: the
     # entries remember which objects they were made for
@@ -93,6 +95,20 @@ def _value_bounds(dae: Any) -> tuple[np.ndarray, np.ndarray]:
         hi = np.array([_bound(d, "max", math.inf) for d in decls], dtype=float)
         seen = dae.cache["value bounds"] = (dae.parameters, dae.inputs, lo, hi)
     return seen[2], seen[3]
+
+
+def _bound_parameters(dae: Any, flat: Any) -> tuple[list, np.ndarray, np.ndarray]:
+    """The parameters of ``flat`` bound to expressions of others, and their declared
+    ``min``/``max`` (-inf/inf: none), kept in ``dae.cache``."""
+    import casadi as ca
+
+    seen = dae.cache.get("bound parameters")
+    if seen is None or seen[0] is not flat.parameters:
+        bound = [q for q in flat.parameters if isinstance(q.decl.value, ca.SX)]
+        lo = np.array([_bound(q.decl, "min", -math.inf) for q in bound], dtype=float)
+        hi = np.array([_bound(q.decl, "max", math.inf) for q in bound], dtype=float)
+        seen = dae.cache["bound parameters"] = (flat.parameters, bound, lo, hi)
+    return seen[1], seen[2], seen[3]
 
 
 def _check_starts(dae: Any, flat: Any) -> None:
@@ -134,5 +150,6 @@ def _declared(v: Any, sep: str = " (") -> str:
 
 
 def _bound_values(dae: Any, bound: list, p: np.ndarray) -> list[float | None]:
-    values = dae.parameter_values(p) if hasattr(dae, "parameter_values") else {}
+    read = getattr(dae, "parameter_values_read", None) or getattr(dae, "parameter_values", None)
+    values = read(p) if read is not None else {}
     return [values.get(q.name) for q in bound]

@@ -203,12 +203,15 @@ def initialize(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
     p = np.asarray(p, dtype=float)
     guess = np.concatenate([x0[free], z0, p[st.params]])
     if "g" not in made:
+        from ..events.fast import Fast
+
         made["pinned"] = [i for i in range(len(x0)) if i not in set(free)]
         made["g"] = _init_residual(dae, st)
+        made["fast g"] = Fast(made["g"])
     pinned, g = made["pinned"], made["g"]
     known = p[st.known_params(len(p))] if st.params else p
     args = np.concatenate([x0[pinned], known, [t0]])
-    r0 = np.asarray(g(guess, args)).ravel()
+    r0 = made["fast g"](guess, args)[0].copy()
     if r0.size and np.max(np.abs(r0)) > tol:
         solver = ca.rootfinder("init", "newton", g, {"abstol": tol, "max_iter": 100,
                                                      "error_on_fail": False})
