@@ -90,11 +90,23 @@ def _value_bounds(dae: Any) -> tuple[np.ndarray, np.ndarray]:
     """Declared ``min``/``max`` of the parameters then the inputs (-inf/inf: none)."""
     seen = dae.cache.get("value bounds")
     if seen is None or seen[0] is not dae.parameters or seen[1] is not dae.inputs:
-        decls = [q.decl for q in (*dae.parameters, *dae.inputs)]
-        lo = np.array([_bound(d, "min", -math.inf) for d in decls], dtype=float)
-        hi = np.array([_bound(d, "max", math.inf) for d in decls], dtype=float)
+        lo, hi = _limits([q.decl for q in (*dae.parameters, *dae.inputs)])
         seen = dae.cache["value bounds"] = (dae.parameters, dae.inputs, lo, hi)
     return seen[2], seen[3]
+
+
+def _limits(decls: list) -> tuple[np.ndarray, np.ndarray]:
+    """Declared ``min``/``max`` of ``decls`` as arrays to compare values with (-inf/inf:
+    none; a NaN bound compares as none, as it does as a float)."""
+    try:
+        lo = np.array([getattr(d, "min", None) for d in decls], dtype=float)
+        hi = np.array([getattr(d, "max", None) for d in decls], dtype=float)
+    except (TypeError, ValueError):      # a bound numpy cannot convert: one at a time
+        lo = np.array([_bound(d, "min", -math.inf) for d in decls], dtype=float)
+        hi = np.array([_bound(d, "max", math.inf) for d in decls], dtype=float)
+    lo[np.isnan(lo)] = -math.inf
+    hi[np.isnan(hi)] = math.inf
+    return lo, hi
 
 
 def _bound_parameters(dae: Any, flat: Any) -> tuple[list, np.ndarray, np.ndarray]:
@@ -105,20 +117,14 @@ def _bound_parameters(dae: Any, flat: Any) -> tuple[list, np.ndarray, np.ndarray
     seen = dae.cache.get("bound parameters")
     if seen is None or seen[0] is not flat.parameters:
         bound = [q for q in flat.parameters if isinstance(q.decl.value, ca.SX)]
-        lo = np.array([_bound(q.decl, "min", -math.inf) for q in bound], dtype=float)
-        hi = np.array([_bound(q.decl, "max", math.inf) for q in bound], dtype=float)
+        lo, hi = _limits([q.decl for q in bound])
         seen = dae.cache["bound parameters"] = (flat.parameters, bound, lo, hi)
     return seen[1], seen[2], seen[3]
 
 
 def _check_starts(dae: Any, flat: Any) -> None:
     """Fixed start values inside their bounds, all start values finite."""
-    wanted = {dae.names[k] for k, _ in dae.fixed}
-    decls: dict[str, Any] = {}
-    if flat is not None and wanted:
-        by_name = getattr(flat.variables, "declarations", None)   # (a large model's)
-        decls = by_name(wanted) if by_name is not None else \
-            {v.name: v.decl for v in flat.variables if v.name in wanted}
+    decls = _fixed_declarations(dae, flat)
     for k, value in dae.fixed:
         name = dae.names[k]
         decl = decls.get(name)
@@ -132,6 +138,23 @@ def _check_starts(dae: Any, flat: Any) -> None:
         for k in np.flatnonzero(~np.isfinite(starts[:len(names)])).tolist()[:1]:
             raise ParameterError(f"start value of {names[k]} is {starts[k]}: it must be a "
                                  "finite number")
+
+
+def _fixed_declarations(dae: Any, flat: Any) -> dict[str, Any]:
+    """The declarations of the variables with a fixed start value, by name (those found in
+    ``flat``)."""
+    if flat is None or not dae.fixed:
+        return {}
+    variables = flat.variables
+    names = getattr(variables, "names", None)       # (a large model's: by position when
+    at = getattr(variables, "declarations_at", None)                   # the names agree)
+    if at is not None and isinstance(names, list) and names == dae.names[:len(names)]:
+        found = [k for k, _ in dae.fixed if k < len(names)]
+        return dict(zip([dae.names[k] for k in found], at(found), strict=True))
+    wanted = {dae.names[k] for k, _ in dae.fixed}
+    by_name = getattr(variables, "declarations", None)
+    return by_name(wanted) if by_name is not None else \
+        {v.name: v.decl for v in variables if v.name in wanted}
 
 
 def _variable(flat: Any, name: str) -> Any:

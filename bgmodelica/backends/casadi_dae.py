@@ -8,6 +8,8 @@ interval). Parameters bound to expressions of other parameters are substituted a
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from itertools import chain
+from operator import attrgetter
 
 import casadi as ca
 import numpy as np
@@ -16,6 +18,8 @@ from ..core.flatmodel import FlatVariable, HybridPart, take
 from ..core.variables import TIME
 from ..errors import ParameterError, UnitError
 from ..passes.sorting import SortedDAE
+
+_DECL, _VALUE, _START = attrgetter("decl"), attrgetter("value"), attrgetter("start")
 
 #: common subexpressions are merged (``casadi.cse``) in models with up to this many
 #: expressions (ODE, residuals, observed): the solved loops of a multibody model repeat
@@ -121,10 +125,12 @@ class CasadiDAE:
 
     @property
     def p_default(self) -> np.ndarray:
-        vals = [float(p.decl.value) for p in self.parameters]
-        vals += [float(u.decl.start) for u in self.inputs]
-        vals += [float(d.decl.start) for d in self.discretes]
-        return np.array(vals, dtype=float)
+        decls = map(_DECL, self.parameters)
+        n = len(self.parameters) + len(self.inputs) + len(self.discretes)
+        return np.fromiter(chain(map(float, map(_VALUE, decls)),
+                                 map(float, map(_START, map(_DECL, self.inputs))),
+                                 map(float, map(_START, map(_DECL, self.discretes)))),
+                           dtype=float, count=n)
 
     def p_vector(self, overrides: dict[str, float] | None = None) -> np.ndarray:
         """Parameter-and-input vector with ``overrides`` applied (by dotted name)."""
