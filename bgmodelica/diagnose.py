@@ -35,38 +35,78 @@ def _kind(v: float) -> str:
     return "NaN" if math.isnan(v) else ("+Inf" if v > 0 else "-Inf")
 
 
-class _Point:
-    """Values of every symbol of a sorted model at one point, and evaluation of expressions."""
+class _Layout:
+    """The symbols a :class:`_Point` gives values to, in order: the sorted model's variables,
+    the parameters, inputs and discretes of ``p`` (its first ``n_p`` entries), the
+    parameters bound to others, time. Made once per model (kept in ``dae.cache``)."""
 
-    def __init__(self, dae: Any, values: dict[str, float], p: np.ndarray, t: float) -> None:
-        from .value_checks import _bound_values
-
-        srt = dae.sorted
-        self.model = srt.model
+    def __init__(self, dae: Any, n_p: int) -> None:
+        self.model = dae.sorted.model
         self.names = self.model.names()
-        syms: list[ca.SX] = []
-        vals: list[float] = []
-        for v in self.model.variables:
-            syms.append(v.sx)
-            vals.append(float(values.get(v.name, math.nan)))
-        p = np.asarray(p, dtype=float)
+        self.variables = [v.name for v in self.model.variables]
+        syms = [v.sx for v in self.model.variables]
         base = list(dae.parameters) + list(dae.inputs) + list(getattr(dae, "discretes", ()))
-        for q, val in zip(base, p, strict=False):
+        self.n_base = min(len(base), n_p)
+        syms += [q.sx for q in base[:self.n_base]]
+        self.bound = [q for q in self.model.parameters if isinstance(q.decl.value, ca.SX)]
+        for q in self.bound:
             syms.append(q.sx)
-            vals.append(float(val))
-        bound = [q for q in self.model.parameters if isinstance(q.decl.value, ca.SX)]
-        if bound:
-            for q, val in zip(bound, _bound_values(dae, bound, p), strict=True):
-                syms.append(q.sx)
-                vals.append(math.nan if val is None else val)
-                self.names[q.sx.element_hash()] = q.name
+            self.names[q.sx.element_hash()] = q.name
         syms.append(TIME.sx)
-        vals.append(float(t))
         self.names[TIME.sx.element_hash()] = "time"
         self.syms = syms
         self.X = ca.vertcat(*syms)
-        self.vals = np.asarray(vals, dtype=float)
-        self.value_of = {s.element_hash(): v for s, v in zip(syms, vals, strict=True)}
+        # where each variable's value is in the observed vector (-1: not observed)
+        n = min(getattr(dae, "n_variables", 0) or len(dae.names), len(dae.names))
+        at = {name: k for k, name in enumerate(dae.names[:n])}
+        self.source = np.array([at.get(name, -1) for name in self.variables], dtype=np.int64)
+
+    @staticmethod
+    def of(dae: Any, n_p: int) -> _Layout:
+        key = ("bgm_point_layout", n_p)
+        found = dae.cache.get(key)
+        if found is None:
+            found = dae.cache[key] = _Layout(dae, n_p)
+        return found
+
+    def values(self, dae: Any, variables: np.ndarray, p: np.ndarray, t: float) -> np.ndarray:
+        """The values of :attr:`syms` given those of the variables (in model order)."""
+        from .value_checks import _bound_values
+
+        bound = [math.nan if v is None else v
+                 for v in _bound_values(dae, self.bound, p)] if self.bound else []
+        return np.concatenate([np.asarray(variables, dtype=float), p[:self.n_base],
+                               np.asarray(bound, dtype=float), [float(t)]])
+
+    def observed_values(self, dae: Any, obs: np.ndarray, p: np.ndarray,
+                        t: float) -> np.ndarray:
+        """The values of :attr:`syms` with the variables read from the observed vector."""
+        obs = np.asarray(obs, dtype=float)
+        src = self.source
+        ok = (src >= 0) & (src < len(obs))
+        got = np.full(len(src), math.nan)
+        got[ok] = obs[src[ok]]
+        return self.values(dae, got, p, t)
+
+
+class _Point:
+    """Values of every symbol of a sorted model at one point, and evaluation of expressions."""
+
+    def __init__(self, dae: Any, values: dict[str, float], p: np.ndarray, t: float,
+                 vals: np.ndarray | None = None) -> None:
+        """``vals``: the values of the layout's symbols when already known."""
+        p = np.asarray(p, dtype=float)
+        layout = _Layout.of(dae, len(p))
+        self.model = layout.model
+        self.names = layout.names
+        if vals is None:
+            got = [float(values.get(n, math.nan)) for n in layout.variables]
+            vals = layout.values(dae, np.asarray(got, dtype=float), p, t)
+        self.syms = layout.syms
+        self.X = layout.X
+        self.vals = vals
+        self.value_of = {s.element_hash(): v
+                         for s, v in zip(layout.syms, vals.tolist(), strict=True)}
         self.t = float(t)
 
     def eval(self, exprs: list[ca.SX]) -> np.ndarray:
@@ -196,13 +236,17 @@ def explain(dae: Any, values: dict[str, float], p: np.ndarray, t: float) -> str:
 
 # -- checks --------------------------------------------------------------------------------------
 
-def _point_function(dae: Any) -> ca.Function:
+def _point_function(dae: Any) -> Any:
+    """``(t, x, z, p) -> (ode, alg, observed)``, dense, with bound buffers
+    (:class:`~bgmodelica.events.fast.Fast`, made once per model)."""
+    from .events.fast import Fast
+
     key = ("bgm_point", dae.x.numel(), dae.z.numel(), dae.p.numel())
     f = dae.cache.get(key)
     if f is None:
-        f = ca.Function("bgm_point", [dae.t, dae.x, dae.z, dae.p],
-                        [dae.ode, dae.alg, dae.observed])
-        dae.cache[key] = f
+        f = dae.cache[key] = Fast(ca.Function(
+            "bgm_point", [dae.t, dae.x, dae.z, dae.p],
+            [ca.densify(e) for e in (dae.ode, dae.alg, dae.observed)]))
     return f
 
 
@@ -213,15 +257,13 @@ def check_initial_point(dae: Any, x0: Any, z0: Any, p: Any, t0: float) -> None:
     x0 = np.asarray(x0, dtype=float).reshape(-1)
     z0 = np.asarray(z0, dtype=float).reshape(-1)
     with np.errstate(all="ignore"):
-        ode, alg, obs = (np.asarray(v, dtype=float).ravel()
-                         for v in f(t0, x0 if dae.x.numel() else np.zeros(0),
-                                    z0 if dae.z.numel() else np.zeros(0), p))
-    n_var = getattr(dae, "n_variables", 0) or len(dae.names)
-    values = {n: float(v) for n, v in zip(dae.names[:n_var], obs, strict=False)}
+        ode, alg, obs = (v.copy() for v in f(t0, x0 if dae.x.numel() else np.zeros(0),
+                                            z0 if dae.z.numel() else np.zeros(0),
+                                            np.asarray(p, dtype=float).ravel()))
     if np.all(np.isfinite(ode)) and np.all(np.isfinite(alg)) and np.all(np.isfinite(obs)):
-        _check_residuals(dae, values, p, t0)
+        _check_residuals(dae, obs, p, t0)
         return
-    why = explain(dae, values, p, t0)
+    why = explain(dae, _values(dae, obs), p, t0)
     if not why:
         bad = [dae.names[k] for k in np.flatnonzero(~np.isfinite(obs))][:5] \
             or [f"der({dae.state_names[k]})" for k in np.flatnonzero(~np.isfinite(ode))][:5] \
@@ -232,26 +274,39 @@ def check_initial_point(dae: Any, x0: Any, z0: Any, p: Any, t0: float) -> None:
                               "parameter and start values")
 
 
-def _check_residuals(dae: Any, values: dict[str, float], p: Any, t0: float) -> None:
-    """Every equation defined at a finite initial point: a solved form can hide an undefined
-    one (``e1 = m*e2`` with ``m = l1/0`` gives ``e2 = e1/m = 0``)."""
+def _values(dae: Any, obs: np.ndarray) -> dict[str, float]:
+    """The variables' values by name, read from the observed vector ``obs``."""
+    n_var = getattr(dae, "n_variables", 0) or len(dae.names)
+    return {n: float(v) for n, v in zip(dae.names[:n_var], obs, strict=False)}
+
+
+def _check_residuals(dae: Any, obs: np.ndarray, p: Any, t0: float) -> None:
+    """Every equation defined at a finite initial point (``obs``: the observed variables
+    there): a solved form can hide an undefined one (``e1 = m*e2`` with ``m = l1/0`` gives
+    ``e2 = e1/m = 0``)."""
     srt = getattr(dae, "sorted", None)
     if srt is None:
         return
-    pt = _Point(dae, values, p, t0)
+    p = np.asarray(p, dtype=float)
+    layout = _Layout.of(dae, len(p))
     f = dae.cache.get("bgm_residuals")
     if f is None:
-        known = {s.element_hash() for s in pt.syms}
+        from .events.fast import Fast
+
+        known = {s.element_hash() for s in layout.syms}
         rows = [k for k, e in enumerate(srt.model.equations)
                 if all(s.element_hash() in known for s in ca.symvar(e.residual))]
         out = ca.vertcat(*[srt.model.equations[k].residual for k in rows]) if rows \
             else ca.SX(0, 1)
-        f = dae.cache["bgm_residuals"] = (ca.Function("bgm_res", [pt.X], [out]), rows)
+        f = dae.cache["bgm_residuals"] = (
+            Fast(ca.Function("bgm_res", [layout.X], [ca.densify(out)])), rows)
     fn, rows = f
+    vals = layout.observed_values(dae, obs, p, t0)
     with np.errstate(all="ignore"):
-        res = np.asarray(fn(pt.vals), dtype=float).ravel()
+        res = fn(vals)[0]
     if np.all(np.isfinite(res)):
         return
+    pt = _Point(dae, {}, p, t0, vals)
     k = rows[int(np.flatnonzero(~np.isfinite(res))[0])]
     op = _operation(pt, srt.model.equations[k].residual) or _constant(
         srt.model.equations[k].residual)

@@ -29,7 +29,7 @@ def _integrator(dae: CasadiDAE, solver: str, t0: float, tout: np.ndarray, opts: 
 
 def _cached_integrator(dae: CasadiDAE, solver: str, t0: float, tout: np.ndarray, opts: dict):
     """The integrator for these settings, reused by repeated runs of the same model."""
-    key = ("integrator", solver, float(t0), tuple(map(float, tout)),
+    key = ("integrator", solver, float(t0), np.asarray(tout, dtype=float).tobytes(),
            tuple(sorted((k, repr(v)) for k, v in opts.items())))
     cache = dae.cache.setdefault("integrators", {})
     if key not in cache:

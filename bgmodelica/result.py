@@ -2,12 +2,66 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, MutableMapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+
+class Deferred(MutableMapping):
+    """A dict made when first used: ``make()`` gives it (a large model's units or aliases
+    then cost nothing until asked for). Reads and writes go to that dict; it pickles and
+    copies as a plain dict."""
+
+    __slots__ = ("_make", "_data")
+
+    def __init__(self, make: Callable[[], dict]) -> None:
+        self._make: Callable[[], dict] | None = make
+        self._data: dict | None = None
+
+    @property
+    def data(self) -> dict:
+        if self._data is None:
+            self._data = self._make()     # type: ignore[misc]
+            self._make = None
+        return self._data
+
+    def __getitem__(self, key: Any) -> Any:
+        return self.data[key]
+
+    def __setitem__(self, key: Any, value: Any) -> None:
+        self.data[key] = value
+
+    def __delitem__(self, key: Any) -> None:
+        del self.data[key]
+
+    def __iter__(self) -> Iterator:
+        return iter(self.data)
+
+    def __len__(self) -> int:
+        return len(self.data)
+
+    def __contains__(self, key: object) -> bool:
+        return key in self.data
+
+    def get(self, key: Any, default: Any = None) -> Any:
+        return self.data.get(key, default)
+
+    def __eq__(self, other: object) -> bool:
+        return self.data == (other.data if isinstance(other, Deferred) else other)
+
+    __hash__ = None     # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        return repr(self.data)
+
+    def copy(self) -> dict:
+        return dict(self.data)
+
+    def __reduce__(self) -> tuple:
+        return (dict, (self.data,))
 
 
 @dataclass
@@ -24,14 +78,21 @@ class Result:
     time: np.ndarray
     data: np.ndarray | Callable[[], np.ndarray]   # (N, len(names)), or computes it on demand
     names: list[str]
-    aliases: dict[str, tuple[str, float]] = field(default_factory=dict)
+    aliases: MutableMapping[str, tuple[str, float]] = field(default_factory=dict)
     parameters: dict[str, float] = field(default_factory=dict)
-    units: dict[str, str] = field(default_factory=dict)
+    units: MutableMapping[str, str] = field(default_factory=dict)
     meta: dict[str, Any] = field(default_factory=dict)
     text: dict[str, list[Any]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        self._index = {n: k for k, n in enumerate(self.names)}
+        self._by_name: dict[str, int] | None = None
+
+    @property
+    def _index(self) -> dict[str, int]:
+        """Name -> column of :attr:`values` (made when first used)."""
+        if self._by_name is None:
+            self._by_name = {n: k for k, n in enumerate(self.names)}
+        return self._by_name
 
     def __repr__(self) -> str:
         """One line: ``Result(RobotPID: 162 variables, 501 points, t = 0..10 s)``."""

@@ -21,7 +21,7 @@ from .errors import ModelError, ParameterError, SimulationError
 from .events.fast import Fast
 from .integration import _integrate, _integrator, _xdot  # noqa: F401 (used by studies)
 from .overrides import split_overrides, with_starts
-from .result import Result
+from .result import Deferred, Result
 from .solver_options import integrator_settings
 from .validate import check_run_options, output_grid
 from .value_checks import check_values
@@ -203,9 +203,9 @@ def simulate(model: Component | CompiledModel | str, stop_time: float = 1.0,
     values = ((lambda: np.asarray(_observer(dae, obs_idx)(grid[:n_ok], xs, zs, p)))
               if n_ok else np.zeros((0, len(obs_idx))))
     run = _time.perf_counter() - t_start
-    names = [dae.names[k] for k in obs_idx]
+    names = list(dae.names) if len(obs_idx) == len(dae.names) else \
+        [dae.names[k] for k in obs_idx]
     flat = compiled.declarations
-    units = _units_by_name(dae, flat)
     params_out = dae.parameter_values(p)
     meta = {"model": compiled.name, "compile_seconds": compiled.compile_time,
             "run_seconds": run,
@@ -213,8 +213,10 @@ def simulate(model: Component | CompiledModel | str, stop_time: float = 1.0,
             "rtol": rtol, "atol": atol,
             **solver_meta, "stats": stats,
             "states": list(dae.state_names), "init_notes": init.notes}
-    aliases = _kept_aliases(dae, flat, obs_idx, names)
-    result = Result(grid[:n_ok], values, names, aliases, params_out, dict(units), meta)
+    # a large model's units and aliases are made when first read
+    aliases = Deferred(lambda: _kept_aliases(dae, flat, obs_idx, names))
+    units = Deferred(lambda: dict(_units_by_name(dae, flat)))
+    result = Result(grid[:n_ok], values, names, aliases, params_out, units, meta)
     if not _finite_run(dae, obs_idx, grid[:n_ok], xs, zs, p):
         check_result(result, dae, p)            # names the variable and time
     if failure is not None:
@@ -301,7 +303,8 @@ def _unsafe(dae: CasadiDAE, idx: Sequence[int]) -> list[int]:
     idx = list(idx)
     if not idx:
         return []
-    expr = dae.observed[idx]
+    whole = len(idx) == dae.observed.numel() and idx == list(range(len(idx)))
+    expr = dae.observed if whole else dae.observed[idx]
     varying = ca.vertcat(dae.t, dae.x, dae.z)
     nonlinear = [k for k, yes in zip(idx, ca.which_depends(expr, varying, 2, True),
                                      strict=True) if yes]

@@ -47,8 +47,6 @@ def check_values(dae: Any, p: np.ndarray, flat: Any = None) -> None:
     expressions of others and the declarations of the variables. The parameters and inputs
     are checked in numpy against bounds kept in ``dae.cache``; the start values, fixed when
     the model was compiled, are checked once per model."""
-    import casadi as ca
-
     p = np.asarray(p, dtype=float)
     n_par, n_in = len(dae.parameters), len(dae.inputs)
     lo, hi = _value_bounds(dae)
@@ -66,13 +64,17 @@ def check_values(dae: Any, p: np.ndarray, flat: Any = None) -> None:
         raise ParameterError(f"discrete variable {bad_discrete[0]} starts at a non-finite "
                              "value")
     if flat is not None:
-        bound = [q for q in flat.parameters if isinstance(q.decl.value, ca.SX)]
+        bound, lo, hi = _bound_parameters(dae, flat)
         if bound:
             values = _bound_values(dae, bound, p)
-            for q, v in zip(bound, values, strict=True):
-                if v is not None:
+            v = np.array([math.nan if x is None else x for x in values], dtype=float)
+            with np.errstate(invalid="ignore"):
+                bad = ~np.isfinite(v) | (v < lo) | (v > hi)
+            for k in np.flatnonzero(bad).tolist():     # the first one raises
+                q = bound[k]
+                if values[k] is not None:
                     comp = f", declared in {q.component}" if q.component else ""
-                    _check_one("parameter", q.name, v, q.decl,
+                    _check_one("parameter", q.name, values[k], q.decl,
                                f" (bound to other parameters{comp})")
     # a DAE copied with other start values (dataclasses.replace) shares the cache: the
     # entries remember which objects they were made for
@@ -88,21 +90,41 @@ def _value_bounds(dae: Any) -> tuple[np.ndarray, np.ndarray]:
     """Declared ``min``/``max`` of the parameters then the inputs (-inf/inf: none)."""
     seen = dae.cache.get("value bounds")
     if seen is None or seen[0] is not dae.parameters or seen[1] is not dae.inputs:
-        decls = [q.decl for q in (*dae.parameters, *dae.inputs)]
-        lo = np.array([_bound(d, "min", -math.inf) for d in decls], dtype=float)
-        hi = np.array([_bound(d, "max", math.inf) for d in decls], dtype=float)
+        lo, hi = _limits([q.decl for q in (*dae.parameters, *dae.inputs)])
         seen = dae.cache["value bounds"] = (dae.parameters, dae.inputs, lo, hi)
     return seen[2], seen[3]
 
 
+def _limits(decls: list) -> tuple[np.ndarray, np.ndarray]:
+    """Declared ``min``/``max`` of ``decls`` as arrays to compare values with (-inf/inf:
+    none; a NaN bound compares as none, as it does as a float)."""
+    try:
+        lo = np.array([getattr(d, "min", None) for d in decls], dtype=float)
+        hi = np.array([getattr(d, "max", None) for d in decls], dtype=float)
+    except (TypeError, ValueError):      # a bound numpy cannot convert: one at a time
+        lo = np.array([_bound(d, "min", -math.inf) for d in decls], dtype=float)
+        hi = np.array([_bound(d, "max", math.inf) for d in decls], dtype=float)
+    lo[np.isnan(lo)] = -math.inf
+    hi[np.isnan(hi)] = math.inf
+    return lo, hi
+
+
+def _bound_parameters(dae: Any, flat: Any) -> tuple[list, np.ndarray, np.ndarray]:
+    """The parameters of ``flat`` bound to expressions of others, and their declared
+    ``min``/``max`` (-inf/inf: none), kept in ``dae.cache``."""
+    import casadi as ca
+
+    seen = dae.cache.get("bound parameters")
+    if seen is None or seen[0] is not flat.parameters:
+        bound = [q for q in flat.parameters if isinstance(q.decl.value, ca.SX)]
+        lo, hi = _limits([q.decl for q in bound])
+        seen = dae.cache["bound parameters"] = (flat.parameters, bound, lo, hi)
+    return seen[1], seen[2], seen[3]
+
+
 def _check_starts(dae: Any, flat: Any) -> None:
     """Fixed start values inside their bounds, all start values finite."""
-    wanted = {dae.names[k] for k, _ in dae.fixed}
-    decls: dict[str, Any] = {}
-    if flat is not None and wanted:
-        by_name = getattr(flat.variables, "declarations", None)   # (a large model's)
-        decls = by_name(wanted) if by_name is not None else \
-            {v.name: v.decl for v in flat.variables if v.name in wanted}
+    decls = _fixed_declarations(dae, flat)
     for k, value in dae.fixed:
         name = dae.names[k]
         decl = decls.get(name)
@@ -116,6 +138,23 @@ def _check_starts(dae: Any, flat: Any) -> None:
         for k in np.flatnonzero(~np.isfinite(starts[:len(names)])).tolist()[:1]:
             raise ParameterError(f"start value of {names[k]} is {starts[k]}: it must be a "
                                  "finite number")
+
+
+def _fixed_declarations(dae: Any, flat: Any) -> dict[str, Any]:
+    """The declarations of the variables with a fixed start value, by name (those found in
+    ``flat``)."""
+    if flat is None or not dae.fixed:
+        return {}
+    variables = flat.variables
+    names = getattr(variables, "names", None)       # (a large model's: by position when
+    at = getattr(variables, "declarations_at", None)                   # the names agree)
+    if at is not None and isinstance(names, list) and names == dae.names[:len(names)]:
+        found = [k for k, _ in dae.fixed if k < len(names)]
+        return dict(zip([dae.names[k] for k in found], at(found), strict=True))
+    wanted = {dae.names[k] for k, _ in dae.fixed}
+    by_name = getattr(variables, "declarations", None)
+    return by_name(wanted) if by_name is not None else \
+        {v.name: v.decl for v in variables if v.name in wanted}
 
 
 def _variable(flat: Any, name: str) -> Any:
@@ -134,5 +173,6 @@ def _declared(v: Any, sep: str = " (") -> str:
 
 
 def _bound_values(dae: Any, bound: list, p: np.ndarray) -> list[float | None]:
-    values = dae.parameter_values(p) if hasattr(dae, "parameter_values") else {}
+    read = getattr(dae, "parameter_values_read", None) or getattr(dae, "parameter_values", None)
+    values = read(p) if read is not None else {}
     return [values.get(q.name) for q in bound]

@@ -245,6 +245,11 @@ class _Variables(Sequence):
         symbols = self.symbols
         return {name: symbols[index[name]].decl for name in names if name in index}
 
+    def declarations_at(self, positions: list[int]) -> list[Any]:
+        """The declarations of the variables at these positions."""
+        symbols = self.symbols
+        return [symbols[k].decl for k in positions]
+
     def _index_of(self) -> dict[str, int]:
         index = self.__dict__.get("_index")
         if index is None:

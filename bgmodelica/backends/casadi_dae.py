@@ -8,6 +8,8 @@ interval). Parameters bound to expressions of other parameters are substituted a
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from itertools import chain
+from operator import attrgetter
 
 import casadi as ca
 import numpy as np
@@ -16,6 +18,8 @@ from ..core.flatmodel import FlatVariable, HybridPart, take
 from ..core.variables import TIME
 from ..errors import ParameterError, UnitError
 from ..passes.sorting import SortedDAE
+
+_DECL, _VALUE, _START = attrgetter("decl"), attrgetter("value"), attrgetter("start")
 
 #: common subexpressions are merged (``casadi.cse``) in models with up to this many
 #: expressions (ODE, residuals, observed): the solved loops of a multibody model repeat
@@ -71,13 +75,28 @@ class CasadiDAE:
                 f"{len(self.names)} observed)")
 
     def parameter_values(self, p: np.ndarray) -> dict[str, float]:
-        """Every parameter's value for the vector ``p``, bound ones included."""
+        """Every parameter's value for the vector ``p``, bound ones included (a new dict)."""
+        return dict(self.parameter_values_read(p))
+
+    def parameter_values_read(self, p: np.ndarray) -> dict[str, float]:
+        """:meth:`parameter_values` to read, not to change: the dict of the last ``p`` is
+        remembered (a run asks for it several times)."""
         names = self.cache.get("parameter names")
         if names is None or names[0] is not self.parameters:
             names = self.cache["parameter names"] = (self.parameters,
                                                      [q.name for q in self.parameters])
-        values = np.asarray(p, dtype=float).ravel()[:len(names[1])].tolist()
-        out = dict(zip(names[1], values, strict=True))
+        key = (self.parameters, self.bound, np.asarray(p, dtype=float).tobytes())
+        last = self.cache.get("parameter values")
+        if last is not None and last[0][0] is key[0] and last[0][1] is key[1] \
+                and last[0][2] == key[2]:
+            return last[1]
+        out = self._parameter_values(p, names[1])
+        self.cache["parameter values"] = (key, out)
+        return out
+
+    def _parameter_values(self, p: np.ndarray, names: list[str]) -> dict[str, float]:
+        values = np.asarray(p, dtype=float).ravel()[:len(names)].tolist()
+        out = dict(zip(names, values, strict=True))
         if self.bound:
             if "bound_values" not in self.cache:
                 free = ca.vertcat(*[q.sx for q in self.parameters]) if self.parameters \
@@ -106,10 +125,12 @@ class CasadiDAE:
 
     @property
     def p_default(self) -> np.ndarray:
-        vals = [float(p.decl.value) for p in self.parameters]
-        vals += [float(u.decl.start) for u in self.inputs]
-        vals += [float(d.decl.start) for d in self.discretes]
-        return np.array(vals, dtype=float)
+        decls = map(_DECL, self.parameters)
+        n = len(self.parameters) + len(self.inputs) + len(self.discretes)
+        return np.fromiter(chain(map(float, map(_VALUE, decls)),
+                                 map(float, map(_START, map(_DECL, self.inputs))),
+                                 map(float, map(_START, map(_DECL, self.discretes)))),
+                           dtype=float, count=n)
 
     def p_vector(self, overrides: dict[str, float] | None = None) -> np.ndarray:
         """Parameter-and-input vector with ``overrides`` applied (by dotted name)."""

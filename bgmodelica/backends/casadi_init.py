@@ -194,19 +194,24 @@ def initialize(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
     compete for); states without a condition keep their start values (a note). Parameters
     declared ``fixed=False`` are solved with them, their values in ``p`` the guesses: ``p``
     is updated in place with the solution (also in the result's ``p``)."""
-    st = init_structure(dae)
-    x0, free = st.x0, st.free
+    st, made = _prepared(dae)
+    x0, free = st.x0.copy(), st.free
     z0 = dae.z_start.copy()
     n_cond = len(st.conditions) + len(st.rows())
     if not n_cond and dae.z.numel() == 0:
         return _surplus_checked(dae, st, p, t0, InitialValues(x0, z0, list(st.notes), p))
     p = np.asarray(p, dtype=float)
     guess = np.concatenate([x0[free], z0, p[st.params]])
-    pinned = [i for i in range(len(x0)) if i not in set(free)]
-    g = _init_residual(dae, st)
+    if "g" not in made:
+        from ..events.fast import Fast
+
+        made["pinned"] = [i for i in range(len(x0)) if i not in set(free)]
+        made["g"] = _init_residual(dae, st)
+        made["fast g"] = Fast(made["g"])
+    pinned, g = made["pinned"], made["g"]
     known = p[st.known_params(len(p))] if st.params else p
     args = np.concatenate([x0[pinned], known, [t0]])
-    r0 = np.asarray(g(guess, args)).ravel()
+    r0 = made["fast g"](guess, args)[0].copy()
     if r0.size and np.max(np.abs(r0)) > tol:
         solver = ca.rootfinder("init", "newton", g, {"abstol": tol, "max_iter": 100,
                                                      "error_on_fail": False})
@@ -234,6 +239,17 @@ def initialize(dae: CasadiDAE, p: np.ndarray, t0: float = 0.0,
     if st.params:
         p[st.params] = guess[len(guess) - len(st.params):]
     return _surplus_checked(dae, st, p, t0, InitialValues(x0, z0, list(st.notes), p))
+
+
+def _prepared(dae: CasadiDAE) -> tuple[InitStructure, dict]:
+    """:func:`init_structure` of ``dae`` (not to be changed: ``x0`` is copied before use)
+    and a dict for what is made from it (the residual function), kept in ``dae.cache`` for
+    these start values and equations (a copy with other start values makes its own)."""
+    made_for = (dae.fixed, dae.x_start, dae.initial, dae.observed, dae.alg, dae.parameters)
+    seen = dae.cache.get("init structure")
+    if seen is None or any(a is not b for a, b in zip(seen[0], made_for, strict=True)):
+        seen = dae.cache["init structure"] = (made_for, init_structure(dae), {})
+    return seen[1], seen[2]
 
 
 def _converged(r: np.ndarray, tol: float) -> bool:
