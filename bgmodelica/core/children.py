@@ -13,14 +13,15 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from .expr import Leaf
 from .variables import Symbol
 
 if TYPE_CHECKING:
     from .component import Element
 
-#: a template's description: (class, _init_call, _name, ((key, declaration), ...),
-#: ((key, description), ...))
-Blueprint = tuple[type, Any, Any, tuple[tuple[str, Any], ...], tuple[tuple[str, Any], ...]]
+#: a template's description: a step per element of the tree, parents first:
+#: (class, _init_call, _name, ((key, declaration), ...), index of the parent step or -1)
+Blueprint = tuple[tuple[type, Any, Any, tuple[tuple[str, Any], ...], int], ...]
 
 _KEY = "_blueprint"
 _LAYOUT = ("_init_call", "_name", "_symbols", "_children", "_equations")
@@ -29,11 +30,13 @@ _PLAIN_CLASSES: dict[type, bool] = {}
 
 def build_child(key: str, template: Element) -> Element:
     """``template.clone()``; an exception of user code names the subcomponent path."""
-    made = template.__dict__.get(_KEY)
-    if made is not None and made[0] is type(template) and made[1] is template._init_call:
-        if made[2] is not None:
-            return _instantiate(made[2])
-        made = None
+    call = template._init_call
+    known = template.__dict__.get(_KEY)
+    if known is not None and known[0] is type(template) and known[1] is call:
+        if known[2] is not None:
+            return _instantiate(known[2])
+    else:
+        known = None
     try:
         child = template.clone()
     except Exception as err:  # noqa: BLE001 -- user code: say where, no traceback
@@ -46,58 +49,71 @@ def build_child(key: str, template: Element) -> Element:
             raise
         raise nested_user_error(user_error(err, f"{type(template).__name__}()"), key,
                                 type(template).__name__) from err
-    call = template._init_call
-    template.__dict__[_KEY] = (type(template), call,
-                               _describe(child) if _plain_call(call) else None)
+    if known is None:
+        steps: list[Any] = []
+        plain = _plain_call(call) and _describe(child, -1, steps)
+        template.__dict__[_KEY] = (type(template), call, tuple(steps) if plain else None)
     return child
 
 
 def _instantiate(blueprint: Blueprint) -> Element:
-    """A fresh element as :func:`_describe` saw one: what its constructor would make."""
-    cls, call, name, decls, kids = blueprint
-    self = object.__new__(cls)
-    attrs = self.__dict__
-    attrs["_init_call"] = call
-    attrs["_name"] = name
-    symbols: dict[str, Symbol] = {}
-    attrs["_symbols"] = symbols
-    children: dict[str, Element] = {}
-    attrs["_children"] = children
-    attrs["_equations"] = []
-    for key, decl in decls:
-        sym = Symbol(key, decl, self)
-        symbols[key] = sym
-        attrs[key] = sym.leaf
-    for key, kid in kids:
-        child = children[key] = attrs[key] = _instantiate(kid)
-        child.__dict__["_name"] = key
-    return self
+    """A fresh element as :func:`_describe` saw one: what its constructor would make. (Its
+    symbols are made as by :func:`~bgmodelica.core.variables.new_symbols`, inlined.)"""
+    new = object.__new__
+    made: list[tuple[dict[str, Any], dict[str, Any]]] = []
+    root = None
+    for cls, call, name, decls, parent in blueprint:
+        self = new(cls)
+        attrs = self.__dict__
+        attrs["_init_call"] = call
+        attrs["_name"] = name
+        symbols: dict[str, Symbol] = {}
+        attrs["_symbols"] = symbols
+        children: dict[str, Element] = {}
+        attrs["_children"] = children
+        attrs["_equations"] = []
+        for key, decl in decls:
+            sym = new(Symbol)
+            sym.name = key
+            sym.decl = decl
+            sym._sx = sym._at = sym.der = sym.der_of = sym.pre = sym.pre_of = None
+            sym.owner = self
+            leaf = new(Leaf)
+            leaf.sym = sym
+            sym.leaf = leaf
+            symbols[key] = sym
+            attrs[key] = leaf
+        if parent < 0:
+            root = self
+        else:
+            up_attrs, up_children = made[parent]
+            up_attrs[name] = up_children[name] = self
+        made.append((attrs, children))
+    return root  # type: ignore[return-value]
 
 
-def _describe(elem: Element) -> Blueprint | None:
-    """The blueprint of a freshly built ``elem`` and its subcomponents, or None when it
-    holds anything else than what the general constructor of a plain class makes."""
+def _describe(elem: Element, parent: int, steps: list[Any]) -> bool:
+    """Append the steps that make a freshly built ``elem`` and its subcomponents to
+    ``steps``; False when it holds anything else than what the general constructor of a
+    plain class makes."""
     attrs = elem.__dict__
     symbols, children = attrs.get("_symbols"), attrs.get("_children")
     if not _plain_class(type(elem)) or type(symbols) is not dict \
             or type(children) is not dict or attrs.get("_equations") != [] \
             or list(attrs) != [*_LAYOUT, *symbols, *children]:
-        return None
+        return False
     decls = []
     for key, sym in symbols.items():
         if type(sym) is not Symbol or sym.name != key or sym.owner is not elem \
-                or attrs[key] is not sym.leaf or sym.der_of is not None \
-                or sym.pre_of is not None or sym.der is not None or sym.pre is not None \
-                or sym._sx is not None or sym._at is not None:
-            return None
+                or attrs[key] is not sym.leaf or type(sym.leaf) is not Leaf \
+                or sym.der_of is not None or sym.pre_of is not None or sym.der is not None \
+                or sym.pre is not None or sym._sx is not None or sym._at is not None:
+            return False
         decls.append((key, sym.decl))
-    kids = []
-    for key, child in children.items():
-        kid = _describe(child) if attrs[key] is child else None
-        if kid is None:
-            return None
-        kids.append((key, kid))
-    return type(elem), attrs["_init_call"], attrs["_name"], tuple(decls), tuple(kids)
+    here = len(steps)
+    steps.append((type(elem), attrs["_init_call"], attrs["_name"], tuple(decls), parent))
+    return all(attrs[key] is child and child._name == key and _describe(child, here, steps)
+               for key, child in children.items())
 
 
 def _plain_call(call: Any) -> bool:

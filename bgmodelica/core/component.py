@@ -53,6 +53,7 @@ from .variables import (
     Symbol,
     element_declarations,
     lookup,
+    new_symbols,
 )
 
 
@@ -74,6 +75,13 @@ class Element:
 
     _declarations: ClassVar[dict[str, Declaration]] = {}
     _templates: ClassVar[dict[str, Element]] = {}
+    #: whether every declaration of the class is a scalar (no array to size at construction)
+    _all_scalar: ClassVar[bool] = True
+    #: a view of many connectors (``connect`` leaves its checks to the view's reader)
+    _group_view: ClassVar[bool] = False
+    #: a connector class whose instances ``connect`` checks as in check_connectable's first
+    #: case, before anything else (set by Connector.__init_subclass__)
+    _plain_connect: ClassVar[bool] = False
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
@@ -91,40 +99,49 @@ class Element:
                 templates[name] = value
         cls._declarations = decls
         cls._templates = templates
+        cls._all_scalar = all(d.shape == () for d in decls.values())
 
     def __new__(cls, *args: Any, **kwargs: Any) -> Element:
         self = super().__new__(cls)
-        object.__setattr__(self, "_init_call", (args, dict(kwargs)))
+        self.__dict__["_init_call"] = (args, kwargs)     # (kwargs: this call's own dict)
         return self
 
     @_gc_paused_init
     def __init__(self, name: str | None = None, **modifiers: Any) -> None:
-        symbols: dict[str, Symbol] = {}
+        cls = type(self)
         attrs = self.__dict__
         attrs["_name"] = name
+        symbols: dict[str, Symbol] = {}
         attrs["_symbols"] = symbols
-        attrs["_children"] = {}
+        children: dict[str, Element] = {}
+        attrs["_children"] = children
         attrs["_equations"] = []
-        nested = {k: v for k, v in modifiers.items() if "." in k} if modifiers else {}
-        local = {k: v for k, v in modifiers.items() if "." not in k} if modifiers else {}
-        for key, decl in type(self)._declarations.items():
-            if decl.shape != ():
-                self._declare_array(key, decl, local.pop(key, None))
-                continue
-            if local and key in local:
-                decl = decl.with_start(local.pop(key))
-            sym = Symbol(key, decl, self)          # _declare_scalar, inlined: hot path
-            symbols[key] = sym
-            attrs[key] = sym.leaf
-        children = attrs["_children"]
-        for key, template in type(self)._templates.items():
+        local: dict[str, Any] = {}
+        nested: dict[str, Any] = {}
+        for k, v in modifiers.items():
+            (nested if "." in k else local)[k] = v
+        decls = cls._declarations
+        if not cls._all_scalar:
+            for key, decl in decls.items():
+                if decl.shape != ():
+                    self._declare_array(key, decl, local.pop(key, None))
+                else:
+                    if key in local:
+                        decl = decl.with_start(local.pop(key))
+                    self._declare_scalar(key, decl)
+        elif local:
+            new_symbols(self, [(key, decl.with_start(local.pop(key)) if key in local else decl)
+                               for key, decl in decls.items()], symbols, attrs)
+        else:
+            new_symbols(self, decls.items(), symbols, attrs)
+        for key, template in cls._templates.items():
             child = build_child(key, template)
-            if local and key in local:
+            if key in local:
                 child.modify(**_as_modifiers(key, local.pop(key)))
             if isinstance(child, ComponentArray) or key in symbols:
                 self.add(key, child)               # (a name taken twice: _add says so)
             else:                                  # self._add, less the checks a class passed
-                object.__setattr__(child, "_name", key)
+                child.__dict__["_name"] = key
                 children[key] = child
                 attrs[key] = child
         if local:
@@ -209,8 +226,9 @@ class Element:
                 f"{name!r} already exists")
         if check_name and not name.isidentifier():
             raise DeclarationError(f"{name!r} is not a valid component name")
-        if name not in type(self)._templates and callable(getattr(type(self), name, None)) \
-                or isinstance(getattr(type(self), name, None), property):
+        attr = _class_attribute(type(self), name)
+        if attr is not None and (name not in type(self)._templates and callable(attr)
+                                 or isinstance(attr, property)):
             raise DeclarationError(
                 f"{name!r} cannot name a subcomponent of {type(self).__name__}: it is a method "
                 "of the class; choose another name")
@@ -232,29 +250,36 @@ class Element:
     def modify(self, **modifiers: Any) -> None:
         """Change parameter values / start values, by local or dotted name."""
         for key, value in modifiers.items():
-            head, _, rest = key.partition(".")
-            if rest:
-                child = self._children.get(head)
-                if child is None:
-                    raise DeclarationError(f"{type(self).__name__} has no subcomponent {head!r}")
-                child.modify(**{rest: value})
-            elif head in self._symbols:
-                sym = self._symbols[head]
-                sym.decl = sym.decl.with_start(value)
-            elif head in self.__dict__.get("_arrays", {}):
-                shape = self._arrays[head]
-                names = element_names(head, shape)
-                values = element_values(value, shape, f"{type(self).__name__}.{head}")
-                for name, v in zip(names, values, strict=True):
-                    if name in self._symbols:
-                        self._symbols[name].decl = self._symbols[name].decl.with_start(v)
-                    else:
-                        self._children[name].modify(**_as_modifiers(name, v))
-            elif head in self._children:
-                self._children[head].modify(**_as_modifiers(head, value))
+            self._modify(key, value)
+
+    def _modify(self, key: str, value: Any) -> None:
+        """``self.modify(**{key: value})``."""
+        head, _, rest = key.partition(".")
+        if rest:
+            child = self._children.get(head)
+            if child is None:
+                raise DeclarationError(f"{type(self).__name__} has no subcomponent {head!r}")
+            if type(child).modify is Element.modify:
+                child._modify(rest, value)
             else:
-                raise DeclarationError(
-                    f"{type(self).__name__} has no parameter or variable {head!r}")
+                child.modify(**{rest: value})
+        elif head in self._symbols:
+            sym = self._symbols[head]
+            sym.decl = sym.decl.with_start(value)
+        elif head in self.__dict__.get("_arrays", {}):
+            shape = self._arrays[head]
+            names = element_names(head, shape)
+            values = element_values(value, shape, f"{type(self).__name__}.{head}")
+            for name, v in zip(names, values, strict=True):
+                if name in self._symbols:
+                    self._symbols[name].decl = self._symbols[name].decl.with_start(v)
+                else:
+                    self._children[name].modify(**_as_modifiers(name, v))
+        elif head in self._children:
+            self._children[head].modify(**_as_modifiers(head, value))
+        else:
+            raise DeclarationError(
+                f"{type(self).__name__} has no parameter or variable {head!r}")
 
     def clone(self) -> Element:
         """A fresh instance built with the same constructor arguments."""
@@ -275,6 +300,20 @@ class Element:
         return f"{type(self).__name__}({self._name or ''})"
 
 
+_TYPE_NAMES = frozenset(dir(type))
+
+
+def _class_attribute(cls: type, name: str) -> Any:
+    """``getattr(cls, name, None)``, answered without a failed lookup when no class of the
+    MRO (nor ``type``) has ``name``: the common case of a new subcomponent's name."""
+    for klass in cls.__mro__:
+        if name in klass.__dict__:
+            return getattr(cls, name, None)
+    if type(cls) is type and name not in _TYPE_NAMES:
+        return None
+    return getattr(cls, name, None)
+
+
 def _as_modifiers(name: str, value: Any) -> dict[str, Any]:
     if not isinstance(value, dict):
         raise DeclarationError(f"modifier for subcomponent {name!r} must be a dict of values")
@@ -291,6 +330,8 @@ class Connector(Element):
                 raise DeclarationError(
                     f"connector {cls.__name__}.{name}: only Potential, Flow, Input and Output "
                     "variables belong in a connector")
+        cls._plain_connect = not issubclass(cls, (ElementArray, ArrayExpr)) \
+            and not cls._group_view
 
     def signature(self) -> dict[str, str]:
         return {name: sym.decl.kind for name, sym in self._symbols.items()}
@@ -307,6 +348,10 @@ class Connection:
 def connect(a: Any, b: Any) -> Any:
     """Join two connectors (potentials equal, flows sum to zero) or two signals; arrays of
     connectors or signals are joined elementwise (a list of :class:`Connection`)."""
+    cls = type(a)
+    if cls is type(b) and issubclass(cls, Connector) and cls._plain_connect \
+            and _same_declarations(a, b):
+        return Connection(a, b)           # the common case: two connectors of one class
     if isinstance(a, (ElementArray, ArrayExpr)) or isinstance(b, (ElementArray, ArrayExpr)):
         return connect_arrays(_as_array(a), _as_array(b), connect)
     if getattr(type(a), "_group_view", False) or getattr(type(b), "_group_view", False):
