@@ -24,7 +24,7 @@ if TYPE_CHECKING:
 Blueprint = tuple[tuple[type, Any, Any, tuple[tuple[str, Any], ...], int], ...]
 
 _KEY = "_blueprint"
-_LAYOUT = ("_init_call", "_name", "_symbols", "_children", "_equations")
+_LAYOUT = ("_init_call", "_name", "_symbols", "_children")
 _PLAIN_CLASSES: dict[type, bool] = {}
 
 
@@ -71,7 +71,6 @@ def _instantiate(blueprint: Blueprint) -> Element:
         attrs["_symbols"] = symbols
         children: dict[str, Element] = {}
         attrs["_children"] = children
-        attrs["_equations"] = []
         for key, decl in decls:
             sym = new(Symbol)
             sym.name = key
@@ -99,7 +98,7 @@ def _describe(elem: Element, parent: int, steps: list[Any]) -> bool:
     attrs = elem.__dict__
     symbols, children = attrs.get("_symbols"), attrs.get("_children")
     if not _plain_class(type(elem)) or type(symbols) is not dict \
-            or type(children) is not dict or attrs.get("_equations") != [] \
+            or type(children) is not dict \
             or list(attrs) != [*_LAYOUT, *symbols, *children]:
         return False
     decls = []

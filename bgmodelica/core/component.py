@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import functools
 import gc
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
@@ -82,6 +82,9 @@ class Element:
     #: a connector class whose instances ``connect`` checks as in check_connectable's first
     #: case, before anything else (set by Connector.__init_subclass__)
     _plain_connect: ClassVar[bool] = False
+    #: equations and connections added to an instance (``connect``, ``equation``): its own
+    #: list, made by the first one (:meth:`_own_equations`)
+    _equations: Sequence[Any] = ()
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
@@ -115,7 +118,6 @@ class Element:
         attrs["_symbols"] = symbols
         children: dict[str, Element] = {}
         attrs["_children"] = children
-        attrs["_equations"] = []
         local: dict[str, Any] = {}
         nested: dict[str, Any] = {}
         for k, v in modifiers.items():
@@ -280,6 +282,13 @@ class Element:
         else:
             raise DeclarationError(
                 f"{type(self).__name__} has no parameter or variable {head!r}")
+
+    def _own_equations(self) -> list[Any]:
+        """This instance's list of added equations (made on first use)."""
+        eqs = self.__dict__.get("_equations")
+        if eqs is None:
+            eqs = self.__dict__["_equations"] = []
+        return eqs
 
     def clone(self) -> Element:
         """A fresh instance built with the same constructor arguments."""
@@ -479,14 +488,17 @@ class Component(Element):
     def connect(self, a: Any, b: Any) -> None:
         """Imperative form of ``connect`` for models assembled in code."""
         made = connect(a, b)
+        eqs = self.__dict__.get("_equations")
+        if eqs is None:
+            eqs = self.__dict__["_equations"] = []
         if isinstance(made, list):
-            self._equations.extend(made)
+            eqs.extend(made)
         else:
-            self._equations.append(made)
+            eqs.append(made)
 
     def equation(self, *eqs: Any) -> None:
         """Imperative form: add equations ``lhs == rhs`` to this component."""
-        self._equations.extend(eqs)
+        self._own_equations().extend(eqs)
 
     def all_equations(self, blocks: bool = False) -> Iterator[Any]:
         """Equations of every class in the hierarchy (base classes first), then added ones;
