@@ -23,13 +23,12 @@ from __future__ import annotations
 import functools
 import gc
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any, ClassVar
 
-import casadi as ca
 import numpy as np
 
-from ..errors import ConnectError, DeclarationError, DuplicateNameError
+from ..errors import DeclarationError, DuplicateNameError
 from ..structure.graph import gc_paused
 from .array_marks import mark_leaves
 from .arrays import (
@@ -37,13 +36,13 @@ from .arrays import (
     ArrayExpr,
     ComponentArray,
     ElementArray,
-    connect_arrays,
     element_names,
     element_values,
     normalize_shape,
 )
 from .children import build_child
-from .expr import Expr, Leaf
+from .connections import Connection, connect
+from .expr import Expr
 from .variables import (
     KIND_FLOW,
     KIND_INPUT,
@@ -52,7 +51,6 @@ from .variables import (
     Declaration,
     Symbol,
     element_declarations,
-    lookup,
     new_symbols,
 )
 
@@ -344,110 +342,6 @@ class Connector(Element):
 
     def signature(self) -> dict[str, str]:
         return {name: sym.decl.kind for name, sym in self._symbols.items()}
-
-
-@dataclass(frozen=True)
-class Connection:
-    """``connect(a, b)``: two connectors, or two causal signals."""
-
-    a: Any
-    b: Any
-
-
-def connect(a: Any, b: Any) -> Any:
-    """Join two connectors (potentials equal, flows sum to zero) or two signals; arrays of
-    connectors or signals are joined elementwise (a list of :class:`Connection`)."""
-    cls = type(a)
-    if cls is type(b) and issubclass(cls, Connector) and cls._plain_connect \
-            and _same_declarations(a, b):
-        return Connection(a, b)           # the common case: two connectors of one class
-    if isinstance(a, (ElementArray, ArrayExpr)) or isinstance(b, (ElementArray, ArrayExpr)):
-        return connect_arrays(_as_array(a), _as_array(b), connect)
-    if getattr(type(a), "_group_view", False) or getattr(type(b), "_group_view", False):
-        return Connection(a, b)           # views of many connectors: checked by their reader
-    check_connectable(a, b)
-    return Connection(a, b)
-
-
-def _symbol_of(x: Any) -> Symbol | None:
-    """The declared symbol behind a leaf expression or an SX symbol, else None."""
-    if isinstance(x, Leaf) and isinstance(x.sym, Symbol):
-        return x.sym
-    if isinstance(x, ca.SX) and x.numel() == 1 and x.is_symbolic():
-        return lookup(x)
-    return None
-
-
-def _describe(x: Any) -> str:
-    if isinstance(x, Element):
-        return f"{type(x).__name__} {x.name or '?'}"
-    sym = _symbol_of(x)
-    return f"{sym.decl.kind} variable {sym.name}" if sym else repr(x)
-
-
-def check_connectable(a: Any, b: Any) -> None:
-    """Raise :class:`ConnectError` unless ``a`` and ``b`` may be connected."""
-    if isinstance(a, Connector) and isinstance(b, Connector):
-        if type(a) is type(b) and _same_declarations(a, b):
-            return
-        sa, sb = a.signature(), b.signature()
-        for name in sa.keys() & sb.keys():
-            if sa[name] != sb[name] and {sa[name], sb[name]} != {KIND_INPUT, KIND_OUTPUT}:
-                raise ConnectError(
-                    f"cannot connect {_describe(a)} to {_describe(b)}: {name} is a {sa[name]} "
-                    f"variable in one and a {sb[name]} variable in the other")
-        if sa.keys() != sb.keys():
-            raise ConnectError(
-                f"cannot connect {_describe(a)} ({', '.join(sa)}) to {_describe(b)} "
-                f"({', '.join(sb)}): incompatible connector types")
-        for name in sa:
-            ua, ub = a._symbols[name].decl.unit, b._symbols[name].decl.unit
-            if ua and ub and ua != ub:
-                raise ConnectError(
-                    f"cannot connect {_describe(a)} to {_describe(b)}: {name} has unit "
-                    f"{ua!r} in one and {ub!r} in the other")
-        return
-    syms = []
-    for x in (a, b):
-        sym = _symbol_of(x)
-        if sym is None:
-            raise ConnectError(
-                f"cannot connect {_describe(a)} to {_describe(b)}: connect() joins two "
-                "connectors or two signal variables (Input/Output)")
-        syms.append(sym)
-    kinds = {s.decl.kind for s in syms}
-    if not kinds <= {KIND_INPUT, KIND_OUTPUT}:
-        raise ConnectError(
-            f"cannot connect {_describe(a)} to {_describe(b)}: only connectors or causal "
-            "signals (Input/Output) can be connected; connect the connectors that hold them")
-    if kinds == {KIND_OUTPUT}:
-        raise ConnectError(f"cannot connect two outputs: {_qualified(syms[0])} and "
-                           f"{_qualified(syms[1])} (an output is connected to inputs)")
-
-
-def _same_declarations(a: Connector, b: Connector) -> bool:
-    """Whether two connectors declare the same variables with the same kinds and units
-    (the common case, two instances of one class, checked without building signatures)."""
-    sa, sb = a._symbols, b._symbols
-    if len(sa) != len(sb):
-        return False
-    for name, sym in sa.items():
-        other = sb.get(name)
-        if other is None:
-            return False
-        da, db = sym.decl, other.decl
-        if da is not db and (da.kind != db.kind or da.unit != db.unit):
-            return False
-    return True
-
-
-def _as_array(x: Any) -> Any:
-    return ElementArray(list(x)) if isinstance(x, ArrayExpr) else x
-
-
-def _qualified(sym: Symbol) -> str:
-    owner = getattr(sym.owner, "name", None)
-    return f"{owner}.{sym.name}" if owner else sym.name
 
 
 class Component(Element):
