@@ -26,6 +26,7 @@ Blueprint = tuple[tuple[type, Any, Any, tuple[tuple[str, Any], ...], int], ...]
 _KEY = "_blueprint"
 _LAYOUT = ("_init_call", "_name", "_symbols", "_children")
 _PLAIN_CLASSES: dict[type, bool] = {}
+_CLASS_BLUEPRINTS: dict[type, Blueprint | None] = {}
 
 
 def build_child(key: str, template: Element) -> Element:
@@ -34,7 +35,7 @@ def build_child(key: str, template: Element) -> Element:
     known = template.__dict__.get(_KEY)
     if known is not None and known[0] is type(template) and known[1] is call:
         if known[2] is not None:
-            return _instantiate(known[2])
+            return instantiate(known[2])
     else:
         known = None
     try:
@@ -56,17 +57,42 @@ def build_child(key: str, template: Element) -> Element:
     return child
 
 
-def _instantiate(blueprint: Blueprint) -> Element:
-    """A fresh element as :func:`_describe` saw one: what its constructor would make. (Its
-    symbols are made as by :func:`~bgmodelica.core.variables.new_symbols`, inlined.)"""
+def class_blueprint(cls: type) -> Blueprint | None:
+    """How to make ``cls()`` for a plain class (:func:`_plain_class`), worked out from the
+    first one built; None for other classes (and while that first one is built)."""
+    if cls in _CLASS_BLUEPRINTS:
+        return _CLASS_BLUEPRINTS[cls]
+    _CLASS_BLUEPRINTS[cls] = None
+    if not _plain_class(cls):
+        return None
+    try:
+        first = cls()
+    except Exception:  # noqa: BLE001 -- the general constructor says what is wrong, each time
+        return None
+    steps: list[Any] = []
+    if _describe(first, -1, steps):
+        _CLASS_BLUEPRINTS[cls] = tuple(steps)
+    return _CLASS_BLUEPRINTS[cls]
+
+
+def instantiate(blueprint: Blueprint, root: Element | None = None,
+                root_name: str | None = None) -> Element:
+    """A fresh element as :func:`_describe` saw one: what its constructor would make; with
+    ``root``, that element (new, its ``_init_call`` set) is filled instead of making one,
+    named ``root_name``. (Symbols are made as by
+    :func:`~bgmodelica.core.variables.new_symbols`, inlined.)"""
     new = object.__new__
     made: list[tuple[dict[str, Any], dict[str, Any]]] = []
-    root = None
     for cls, call, name, decls, parent in blueprint:
-        self = new(cls)
-        attrs = self.__dict__
-        attrs["_init_call"] = call
-        attrs["_name"] = name
+        if parent < 0 and root is not None:
+            self = root
+            attrs = self.__dict__
+            attrs["_name"] = root_name
+        else:
+            self = new(cls)
+            attrs = self.__dict__
+            attrs["_init_call"] = call
+            attrs["_name"] = name
         symbols: dict[str, Symbol] = {}
         attrs["_symbols"] = symbols
         children: dict[str, Element] = {}

@@ -40,7 +40,7 @@ from .arrays import (
     element_values,
     normalize_shape,
 )
-from .children import build_child
+from .children import build_child, class_blueprint, instantiate
 from .connections import Connection, connect
 from .expr import Expr
 from .variables import (
@@ -110,16 +110,46 @@ class Element:
     @_gc_paused_init
     def __init__(self, name: str | None = None, **modifiers: Any) -> None:
         cls = type(self)
+        local: dict[str, Any] = {}
+        nested: dict[str, Any] = {}
+        for k, v in modifiers.items():
+            (nested if "." in k else local)[k] = v
+        blueprint = class_blueprint(cls)
+        if blueprint is not None:              # a plain class: as its first instance, then
+            instantiate(blueprint, self, name)  # the modifiers in the order below
+            if local:
+                self.__modify_locals(local)
+        else:
+            self.__build(name, local)
+        if local:
+            raise DeclarationError(
+                f"{type(self).__name__} has no parameter, variable or subcomponent "
+                f"{', '.join(map(repr, local))}; it has: {', '.join(self._symbols) or 'none'}")
+        if nested:
+            self.modify(**nested)
+
+    def __modify_locals(self, local: dict[str, Any]) -> None:
+        """Apply (and pop) the constructor's modifiers of declarations, then of
+        subcomponents, in the class's order."""
+        cls, symbols, children = type(self), self._symbols, self._children
+        for key in cls._declarations:
+            if key in local:
+                sym = symbols[key]
+                sym.decl = sym.decl.with_start(local.pop(key))
+        for key in cls._templates:
+            if key in local:
+                children[key].modify(**_as_modifiers(key, local.pop(key)))
+
+    def __build(self, name: str | None, local: dict[str, Any]) -> None:
+        """The constructor's symbols and subcomponents, ``local`` modifiers applied (and
+        popped) as they are made."""
+        cls = type(self)
         attrs = self.__dict__
         attrs["_name"] = name
         symbols: dict[str, Symbol] = {}
         attrs["_symbols"] = symbols
         children: dict[str, Element] = {}
         attrs["_children"] = children
-        local: dict[str, Any] = {}
-        nested: dict[str, Any] = {}
-        for k, v in modifiers.items():
-            (nested if "." in k else local)[k] = v
         decls = cls._declarations
         if not cls._all_scalar:
             for key, decl in decls.items():
@@ -144,12 +174,6 @@ class Element:
                 child.__dict__["_name"] = key
                 children[key] = child
                 attrs[key] = child
-        if local:
-            raise DeclarationError(
-                f"{type(self).__name__} has no parameter, variable or subcomponent "
-                f"{', '.join(map(repr, local))}; it has: {', '.join(self._symbols) or 'none'}")
-        if nested:
-            self.modify(**nested)
 
     def _declare_array(self, key: str, decl: Declaration, modifier: Any) -> None:
         """The scalars ``key[1] .. key[n]`` of an array declaration, and ``self.key`` as
@@ -250,9 +274,9 @@ class Element:
     def modify(self, **modifiers: Any) -> None:
         """Change parameter values / start values, by local or dotted name."""
         for key, value in modifiers.items():
-            self._modify(key, value)
+            self.__modify_one(key, value)
 
-    def _modify(self, key: str, value: Any) -> None:
+    def __modify_one(self, key: str, value: Any) -> None:
         """``self.modify(**{key: value})``."""
         head, _, rest = key.partition(".")
         if rest:
@@ -260,7 +284,7 @@ class Element:
             if child is None:
                 raise DeclarationError(f"{type(self).__name__} has no subcomponent {head!r}")
             if type(child).modify is Element.modify:
-                child._modify(rest, value)
+                child.__modify_one(rest, value)
             else:
                 child.modify(**{rest: value})
         elif head in self._symbols:
