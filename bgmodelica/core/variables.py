@@ -85,7 +85,11 @@ class Parameter(Declaration):
     kind = KIND_PARAMETER
 
     def with_start(self, value: Any) -> Parameter:
-        return self.evolve(value=value)
+        new = object.__new__(type(self))     # self.evolve(value=value), inlined: hot path
+        fields = new.__dict__
+        fields.update(self.__dict__)
+        fields["value"] = value
+        return new
 
 
 @dataclass(frozen=True)
@@ -118,7 +122,12 @@ class Variable(Declaration):
                 raise DeclarationError(f"bad modifier {value!r}: {err}") from None
         if isinstance(value, str):
             value = _start_number(value, self.unit)
-        return self.evolve(start=value, fixed=True)
+        new = object.__new__(type(self))     # self.evolve(start=value, fixed=True), inlined
+        fields = new.__dict__
+        fields.update(self.__dict__)
+        fields["start"] = value
+        fields["fixed"] = True
+        return new
 
 
 def _start_number(text: str, unit: str) -> float | str:
