@@ -5,8 +5,9 @@ the template's constructor arguments (``template.clone()``). Templates are built
 thousand in a large model, so the first copy of a template whose class runs no code of its
 own (:func:`_plain_class`) is described (:func:`_describe`): its class, its declarations
 with their modifiers applied, and so on down its subcomponents. Later copies are made from
-that description (:func:`_instantiate`): same symbols, same declaration objects (immutable,
-so shared), no constructor machinery.
+that description (:func:`instantiate`): same symbols, same declaration objects (immutable,
+so shared), no constructor machinery. Instances of such a class built directly start the
+same way, from a description of the class's first instance (:func:`class_blueprint`).
 """
 
 from __future__ import annotations
@@ -63,7 +64,7 @@ def class_blueprint(cls: type) -> Blueprint | None:
     if cls in _CLASS_BLUEPRINTS:
         return _CLASS_BLUEPRINTS[cls]
     _CLASS_BLUEPRINTS[cls] = None
-    if not _plain_class(cls):
+    if not _plain_tree(cls):
         return None
     try:
         first = cls()
@@ -139,6 +140,13 @@ def _describe(elem: Element, parent: int, steps: list[Any]) -> bool:
     steps.append((type(elem), attrs["_init_call"], attrs["_name"], tuple(decls), parent))
     return all(attrs[key] is child and child._name == key and _describe(child, here, steps)
                for key, child in children.items())
+
+
+def _plain_tree(cls: type) -> bool:
+    """Whether ``cls()`` runs only :class:`Element`'s code, down its subcomponents (so that
+    building a first one to describe runs no code of the user's once more)."""
+    return _plain_class(cls) and all(
+        _plain_call(t._init_call) and _plain_tree(type(t)) for t in cls._templates.values())
 
 
 def _plain_call(call: Any) -> bool:
