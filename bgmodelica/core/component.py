@@ -107,38 +107,40 @@ class Element:
         self.__dict__["_init_call"] = (args, kwargs)     # (kwargs: this call's own dict)
         return self
 
-    @_gc_paused_init
     def __init__(self, name: str | None = None, **modifiers: Any) -> None:
-        cls = type(self)
-        local: dict[str, Any] = {}
-        nested: dict[str, Any] = {}
-        for k, v in modifiers.items():
-            (nested if "." in k else local)[k] = v
-        blueprint = class_blueprint(cls)
-        if blueprint is not None:              # a plain class: as its first instance, then
-            instantiate(blueprint, self, name)  # the modifiers in the order below
+        enabled = gc.isenabled()               # as _gc_paused_init, inlined: the outermost
+        if enabled:                            # constructor pauses the collector
+            gc.disable()
+        try:
+            cls = type(self)
+            local: dict[str, Any] = {}
+            nested: dict[str, Any] = {}
+            for k, v in modifiers.items():
+                (nested if "." in k else local)[k] = v
+            blueprint = class_blueprint(cls)
+            if blueprint is None:
+                self.__build(name, local)
+            else:                              # a plain class: as its first instance, then
+                instantiate(blueprint, self, name)     # its modifiers, in the class's order
+                if local:
+                    symbols, children = self._symbols, self._children
+                    for key in cls._declarations:
+                        if key in local:
+                            sym = symbols[key]
+                            sym.decl = sym.decl.with_start(local.pop(key))
+                    for key in cls._templates:
+                        if key in local:
+                            children[key].modify(**_as_modifiers(key, local.pop(key)))
             if local:
-                self.__modify_locals(local)
-        else:
-            self.__build(name, local)
-        if local:
-            raise DeclarationError(
-                f"{type(self).__name__} has no parameter, variable or subcomponent "
-                f"{', '.join(map(repr, local))}; it has: {', '.join(self._symbols) or 'none'}")
-        if nested:
-            self.modify(**nested)
-
-    def __modify_locals(self, local: dict[str, Any]) -> None:
-        """Apply (and pop) the constructor's modifiers of declarations, then of
-        subcomponents, in the class's order."""
-        cls, symbols, children = type(self), self._symbols, self._children
-        for key in cls._declarations:
-            if key in local:
-                sym = symbols[key]
-                sym.decl = sym.decl.with_start(local.pop(key))
-        for key in cls._templates:
-            if key in local:
-                children[key].modify(**_as_modifiers(key, local.pop(key)))
+                raise DeclarationError(
+                    f"{type(self).__name__} has no parameter, variable or subcomponent "
+                    f"{', '.join(map(repr, local))}; it has: "
+                    f"{', '.join(self._symbols) or 'none'}")
+            if nested:
+                self.modify(**nested)
+        finally:
+            if enabled:
+                gc.enable()
 
     def __build(self, name: str | None, local: dict[str, Any]) -> None:
         """The constructor's symbols and subcomponents, ``local`` modifiers applied (and
