@@ -22,28 +22,27 @@ from __future__ import annotations
 
 import functools
 import gc
-from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass, replace
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from dataclasses import replace
 from typing import Any, ClassVar
 
-import casadi as ca
 import numpy as np
 
-from ..errors import ConnectError, DeclarationError, DuplicateNameError
-from ..structure.collector import collect_if_due, gc_paused
+from ..errors import DeclarationError, DuplicateNameError
+from ..structure.collector import gc_paused, pause, resume
 from .array_marks import mark_leaves
 from .arrays import (
     ArrayEquation,
     ArrayExpr,
     ComponentArray,
     ElementArray,
-    connect_arrays,
     element_names,
     element_values,
     normalize_shape,
 )
-from .children import build_child
-from .expr import Expr, Leaf
+from .children import build_child, class_blueprint, instantiate
+from .connections import Connection, connect
+from .expr import Expr
 from .variables import (
     KIND_FLOW,
     KIND_INPUT,
@@ -52,7 +51,7 @@ from .variables import (
     Declaration,
     Symbol,
     element_declarations,
-    lookup,
+    new_symbols,
 )
 
 
@@ -64,8 +63,7 @@ def _gc_paused_init(init: Callable[..., None]) -> Callable[..., None]:
     def paused(self: Any, *args: Any, **kwargs: Any) -> None:
         if not gc.isenabled():
             return init(self, *args, **kwargs)
-        collect_if_due()                   # the models built and dropped before this one
-        with gc_paused():
+        with gc_paused(new_model=True):
             return init(self, *args, **kwargs)
     return paused
 
@@ -75,6 +73,16 @@ class Element:
 
     _declarations: ClassVar[dict[str, Declaration]] = {}
     _templates: ClassVar[dict[str, Element]] = {}
+    #: whether every declaration of the class is a scalar (no array to size at construction)
+    _all_scalar: ClassVar[bool] = True
+    #: a view of many connectors (``connect`` leaves its checks to the view's reader)
+    _group_view: ClassVar[bool] = False
+    #: a connector class whose instances ``connect`` checks as in check_connectable's first
+    #: case, before anything else (set by Connector.__init_subclass__)
+    _plain_connect: ClassVar[bool] = False
+    #: equations and connections added to an instance (``connect``, ``equation``): its own
+    #: list, made by the first one (:meth:`_own_equations`)
+    _equations: Sequence[Any] = ()
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
@@ -92,48 +100,80 @@ class Element:
                 templates[name] = value
         cls._declarations = decls
         cls._templates = templates
+        cls._all_scalar = all(d.shape == () for d in decls.values())
 
     def __new__(cls, *args: Any, **kwargs: Any) -> Element:
         self = super().__new__(cls)
-        object.__setattr__(self, "_init_call", (args, dict(kwargs)))
+        self.__dict__["_init_call"] = (args, kwargs)     # (kwargs: this call's own dict)
         return self
 
-    @_gc_paused_init
     def __init__(self, name: str | None = None, **modifiers: Any) -> None:
-        symbols: dict[str, Symbol] = {}
+        enabled = pause(new_model=True)        # as _gc_paused_init, inlined: the outermost
+        try:                                   # constructor pauses the collector
+            cls = type(self)
+            local: dict[str, Any] = {}
+            nested: dict[str, Any] = {}
+            for k, v in modifiers.items():
+                (nested if "." in k else local)[k] = v
+            blueprint = class_blueprint(cls)
+            if blueprint is None:
+                self.__build(name, local)
+            else:                              # a plain class: as its first instance, then
+                instantiate(blueprint, self, name)     # its modifiers, in the class's order
+                if local:
+                    symbols, children = self._symbols, self._children
+                    for key in cls._declarations:
+                        if key in local:
+                            sym = symbols[key]
+                            sym.decl = sym.decl.with_start(local.pop(key))
+                    for key in cls._templates:
+                        if key in local:
+                            children[key].modify(**_as_modifiers(key, local.pop(key)))
+            if local:
+                raise DeclarationError(
+                    f"{type(self).__name__} has no parameter, variable or subcomponent "
+                    f"{', '.join(map(repr, local))}; it has: "
+                    f"{', '.join(self._symbols) or 'none'}")
+            if nested:
+                self.modify(**nested)
+        finally:
+            if enabled:
+                resume()
+
+    def __build(self, name: str | None, local: dict[str, Any]) -> None:
+        """The constructor's symbols and subcomponents, ``local`` modifiers applied (and
+        popped) as they are made."""
+        cls = type(self)
         attrs = self.__dict__
         attrs["_name"] = name
+        symbols: dict[str, Symbol] = {}
         attrs["_symbols"] = symbols
-        attrs["_children"] = {}
-        attrs["_equations"] = []
-        nested = {k: v for k, v in modifiers.items() if "." in k} if modifiers else {}
-        local = {k: v for k, v in modifiers.items() if "." not in k} if modifiers else {}
-        for key, decl in type(self)._declarations.items():
-            if decl.shape != ():
-                self._declare_array(key, decl, local.pop(key, None))
-                continue
-            if local and key in local:
-                decl = decl.with_start(local.pop(key))
-            sym = Symbol(key, decl, self)          # _declare_scalar, inlined: hot path
-            symbols[key] = sym
-            attrs[key] = sym.leaf
-        children = attrs["_children"]
-        for key, template in type(self)._templates.items():
+        children: dict[str, Element] = {}
+        attrs["_children"] = children
+        decls = cls._declarations
+        if not cls._all_scalar:
+            for key, decl in decls.items():
+                if decl.shape != ():
+                    self._declare_array(key, decl, local.pop(key, None))
+                else:
+                    if key in local:
+                        decl = decl.with_start(local.pop(key))
+                    self._declare_scalar(key, decl)
+        elif local:
+            new_symbols(self, [(key, decl.with_start(local.pop(key)) if key in local else decl)
+                               for key, decl in decls.items()], symbols, attrs)
+        else:
+            new_symbols(self, decls.items(), symbols, attrs)
+        for key, template in cls._templates.items():
             child = build_child(key, template)
-            if local and key in local:
+            if key in local:
                 child.modify(**_as_modifiers(key, local.pop(key)))
             if isinstance(child, ComponentArray) or key in symbols:
                 self.add(key, child)               # (a name taken twice: _add says so)
             else:                                  # self._add, less the checks a class passed
-                object.__setattr__(child, "_name", key)
+                child.__dict__["_name"] = key
                 children[key] = child
                 attrs[key] = child
-        if local:
-            raise DeclarationError(
-                f"{type(self).__name__} has no parameter, variable or subcomponent "
-                f"{', '.join(map(repr, local))}; it has: {', '.join(self._symbols) or 'none'}")
-        if nested:
-            self.modify(**nested)
 
     def _declare_array(self, key: str, decl: Declaration, modifier: Any) -> None:
         """The scalars ``key[1] .. key[n]`` of an array declaration, and ``self.key`` as
@@ -210,8 +250,9 @@ class Element:
                 f"{name!r} already exists")
         if check_name and not name.isidentifier():
             raise DeclarationError(f"{name!r} is not a valid component name")
-        if name not in type(self)._templates and callable(getattr(type(self), name, None)) \
-                or isinstance(getattr(type(self), name, None), property):
+        attr = _class_attribute(type(self), name)
+        if attr is not None and (name not in type(self)._templates and callable(attr)
+                                 or isinstance(attr, property)):
             raise DeclarationError(
                 f"{name!r} cannot name a subcomponent of {type(self).__name__}: it is a method "
                 "of the class; choose another name")
@@ -233,29 +274,43 @@ class Element:
     def modify(self, **modifiers: Any) -> None:
         """Change parameter values / start values, by local or dotted name."""
         for key, value in modifiers.items():
-            head, _, rest = key.partition(".")
-            if rest:
-                child = self._children.get(head)
-                if child is None:
-                    raise DeclarationError(f"{type(self).__name__} has no subcomponent {head!r}")
-                child.modify(**{rest: value})
-            elif head in self._symbols:
-                sym = self._symbols[head]
-                sym.decl = sym.decl.with_start(value)
-            elif head in self.__dict__.get("_arrays", {}):
-                shape = self._arrays[head]
-                names = element_names(head, shape)
-                values = element_values(value, shape, f"{type(self).__name__}.{head}")
-                for name, v in zip(names, values, strict=True):
-                    if name in self._symbols:
-                        self._symbols[name].decl = self._symbols[name].decl.with_start(v)
-                    else:
-                        self._children[name].modify(**_as_modifiers(name, v))
-            elif head in self._children:
-                self._children[head].modify(**_as_modifiers(head, value))
+            self.__modify_one(key, value)
+
+    def __modify_one(self, key: str, value: Any) -> None:
+        """``self.modify(**{key: value})``."""
+        head, _, rest = key.partition(".")
+        if rest:
+            child = self._children.get(head)
+            if child is None:
+                raise DeclarationError(f"{type(self).__name__} has no subcomponent {head!r}")
+            if type(child).modify is Element.modify:
+                child.__modify_one(rest, value)
             else:
-                raise DeclarationError(
-                    f"{type(self).__name__} has no parameter or variable {head!r}")
+                child.modify(**{rest: value})
+        elif head in self._symbols:
+            sym = self._symbols[head]
+            sym.decl = sym.decl.with_start(value)
+        elif head in self.__dict__.get("_arrays", {}):
+            shape = self._arrays[head]
+            names = element_names(head, shape)
+            values = element_values(value, shape, f"{type(self).__name__}.{head}")
+            for name, v in zip(names, values, strict=True):
+                if name in self._symbols:
+                    self._symbols[name].decl = self._symbols[name].decl.with_start(v)
+                else:
+                    self._children[name].modify(**_as_modifiers(name, v))
+        elif head in self._children:
+            self._children[head].modify(**_as_modifiers(head, value))
+        else:
+            raise DeclarationError(
+                f"{type(self).__name__} has no parameter or variable {head!r}")
+
+    def _own_equations(self) -> list[Any]:
+        """This instance's list of added equations (made on first use)."""
+        eqs = self.__dict__.get("_equations")
+        if eqs is None:
+            eqs = self.__dict__["_equations"] = []
+        return eqs
 
     def clone(self) -> Element:
         """A fresh instance built with the same constructor arguments."""
@@ -276,6 +331,20 @@ class Element:
         return f"{type(self).__name__}({self._name or ''})"
 
 
+_TYPE_NAMES = frozenset(dir(type))
+
+
+def _class_attribute(cls: type, name: str) -> Any:
+    """``getattr(cls, name, None)``, answered without a failed lookup when no class of the
+    MRO (nor ``type``) has ``name``: the common case of a new subcomponent's name."""
+    for klass in cls.__mro__:
+        if name in klass.__dict__:
+            return getattr(cls, name, None)
+    if type(cls) is type and name not in _TYPE_NAMES:
+        return None
+    return getattr(cls, name, None)
+
+
 def _as_modifiers(name: str, value: Any) -> dict[str, Any]:
     if not isinstance(value, dict):
         raise DeclarationError(f"modifier for subcomponent {name!r} must be a dict of values")
@@ -292,109 +361,11 @@ class Connector(Element):
                 raise DeclarationError(
                     f"connector {cls.__name__}.{name}: only Potential, Flow, Input and Output "
                     "variables belong in a connector")
+        cls._plain_connect = not issubclass(cls, (ElementArray, ArrayExpr)) \
+            and not cls._group_view
 
     def signature(self) -> dict[str, str]:
         return {name: sym.decl.kind for name, sym in self._symbols.items()}
-
-
-@dataclass(frozen=True)
-class Connection:
-    """``connect(a, b)``: two connectors, or two causal signals."""
-
-    a: Any
-    b: Any
-
-
-def connect(a: Any, b: Any) -> Any:
-    """Join two connectors (potentials equal, flows sum to zero) or two signals; arrays of
-    connectors or signals are joined elementwise (a list of :class:`Connection`)."""
-    if isinstance(a, (ElementArray, ArrayExpr)) or isinstance(b, (ElementArray, ArrayExpr)):
-        return connect_arrays(_as_array(a), _as_array(b), connect)
-    if getattr(type(a), "_group_view", False) or getattr(type(b), "_group_view", False):
-        return Connection(a, b)           # views of many connectors: checked by their reader
-    check_connectable(a, b)
-    return Connection(a, b)
-
-
-def _symbol_of(x: Any) -> Symbol | None:
-    """The declared symbol behind a leaf expression or an SX symbol, else None."""
-    if isinstance(x, Leaf) and isinstance(x.sym, Symbol):
-        return x.sym
-    if isinstance(x, ca.SX) and x.numel() == 1 and x.is_symbolic():
-        return lookup(x)
-    return None
-
-
-def _describe(x: Any) -> str:
-    if isinstance(x, Element):
-        return f"{type(x).__name__} {x.name or '?'}"
-    sym = _symbol_of(x)
-    return f"{sym.decl.kind} variable {sym.name}" if sym else repr(x)
-
-
-def check_connectable(a: Any, b: Any) -> None:
-    """Raise :class:`ConnectError` unless ``a`` and ``b`` may be connected."""
-    if isinstance(a, Connector) and isinstance(b, Connector):
-        if type(a) is type(b) and _same_declarations(a, b):
-            return
-        sa, sb = a.signature(), b.signature()
-        for name in sa.keys() & sb.keys():
-            if sa[name] != sb[name] and {sa[name], sb[name]} != {KIND_INPUT, KIND_OUTPUT}:
-                raise ConnectError(
-                    f"cannot connect {_describe(a)} to {_describe(b)}: {name} is a {sa[name]} "
-                    f"variable in one and a {sb[name]} variable in the other")
-        if sa.keys() != sb.keys():
-            raise ConnectError(
-                f"cannot connect {_describe(a)} ({', '.join(sa)}) to {_describe(b)} "
-                f"({', '.join(sb)}): incompatible connector types")
-        for name in sa:
-            ua, ub = a._symbols[name].decl.unit, b._symbols[name].decl.unit
-            if ua and ub and ua != ub:
-                raise ConnectError(
-                    f"cannot connect {_describe(a)} to {_describe(b)}: {name} has unit "
-                    f"{ua!r} in one and {ub!r} in the other")
-        return
-    syms = []
-    for x in (a, b):
-        sym = _symbol_of(x)
-        if sym is None:
-            raise ConnectError(
-                f"cannot connect {_describe(a)} to {_describe(b)}: connect() joins two "
-                "connectors or two signal variables (Input/Output)")
-        syms.append(sym)
-    kinds = {s.decl.kind for s in syms}
-    if not kinds <= {KIND_INPUT, KIND_OUTPUT}:
-        raise ConnectError(
-            f"cannot connect {_describe(a)} to {_describe(b)}: only connectors or causal "
-            "signals (Input/Output) can be connected; connect the connectors that hold them")
-    if kinds == {KIND_OUTPUT}:
-        raise ConnectError(f"cannot connect two outputs: {_qualified(syms[0])} and "
-                           f"{_qualified(syms[1])} (an output is connected to inputs)")
-
-
-def _same_declarations(a: Connector, b: Connector) -> bool:
-    """Whether two connectors declare the same variables with the same kinds and units
-    (the common case, two instances of one class, checked without building signatures)."""
-    sa, sb = a._symbols, b._symbols
-    if len(sa) != len(sb):
-        return False
-    for name, sym in sa.items():
-        other = sb.get(name)
-        if other is None:
-            return False
-        da, db = sym.decl, other.decl
-        if da is not db and (da.kind != db.kind or da.unit != db.unit):
-            return False
-    return True
-
-
-def _as_array(x: Any) -> Any:
-    return ElementArray(list(x)) if isinstance(x, ArrayExpr) else x
-
-
-def _qualified(sym: Symbol) -> str:
-    owner = getattr(sym.owner, "name", None)
-    return f"{owner}.{sym.name}" if owner else sym.name
 
 
 class Component(Element):
@@ -435,14 +406,17 @@ class Component(Element):
     def connect(self, a: Any, b: Any) -> None:
         """Imperative form of ``connect`` for models assembled in code."""
         made = connect(a, b)
+        eqs = self.__dict__.get("_equations")
+        if eqs is None:
+            eqs = self.__dict__["_equations"] = []
         if isinstance(made, list):
-            self._equations.extend(made)
+            eqs.extend(made)
         else:
-            self._equations.append(made)
+            eqs.append(made)
 
     def equation(self, *eqs: Any) -> None:
         """Imperative form: add equations ``lhs == rhs`` to this component."""
-        self._equations.extend(eqs)
+        self._own_equations().extend(eqs)
 
     def all_equations(self, blocks: bool = False) -> Iterator[Any]:
         """Equations of every class in the hierarchy (base classes first), then added ones;

@@ -28,7 +28,8 @@ import numpy as np
 
 from .array_marks import mark_leaves
 from .arrays import ArrayEquation, ArrayExpr
-from .component import Component, Connection, Connector, _own_methods, check_connectable
+from .component import Component, Connection, Connector, _own_methods
+from .connections import check_connectable
 from .expr import Leaf
 
 #: plain attribute values a view hands out when every element has the same one

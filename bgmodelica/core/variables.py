@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import functools
 import weakref
+from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from enum import IntEnum
 from typing import Any
@@ -84,7 +85,11 @@ class Parameter(Declaration):
     kind = KIND_PARAMETER
 
     def with_start(self, value: Any) -> Parameter:
-        return self.evolve(value=value)
+        new = object.__new__(type(self))     # self.evolve(value=value), inlined: hot path
+        fields = new.__dict__
+        fields.update(self.__dict__)
+        fields["value"] = value
+        return new
 
 
 @dataclass(frozen=True)
@@ -117,7 +122,12 @@ class Variable(Declaration):
                 raise DeclarationError(f"bad modifier {value!r}: {err}") from None
         if isinstance(value, str):
             value = _start_number(value, self.unit)
-        return self.evolve(start=value, fixed=True)
+        new = object.__new__(type(self))     # self.evolve(start=value, fixed=True), inlined
+        fields = new.__dict__
+        fields.update(self.__dict__)
+        fields["start"] = value
+        fields["fixed"] = True
+        return new
 
 
 def _start_number(text: str, unit: str) -> float | str:
@@ -337,6 +347,25 @@ class Symbol:
 
     def __repr__(self) -> str:
         return f"Symbol({self.name!r}, {type(self.decl).__name__})"
+
+
+def new_symbols(owner: Any, decls: Iterable[tuple[str, Declaration]],
+                symbols: dict[str, Symbol], attrs: dict[str, Any]) -> None:
+    """A :class:`Symbol` of ``owner`` per ``(key, declaration)``, in ``symbols[key]``, its
+    leaf in ``attrs[key]``: ``Symbol(key, decl, owner)`` made in one loop (an element's
+    symbols are made by the hundred thousand in a large model)."""
+    new = object.__new__
+    for key, decl in decls:
+        sym = new(Symbol)                     # as Symbol.__init__, without its frame
+        sym.name = key
+        sym.decl = decl
+        sym._sx = sym._at = sym.der = sym.der_of = sym.pre = sym.pre_of = None
+        sym.owner = owner
+        leaf = new(Leaf)
+        leaf.sym = sym
+        sym.leaf = leaf
+        symbols[key] = sym
+        attrs[key] = leaf
 
 
 class _Time:

@@ -22,7 +22,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
-__all__ = ["collect_if_due", "gc_paused"]
+__all__ = ["collect_if_due", "gc_paused", "pause", "resume"]
 
 _LARGE = 100_000          # objects made by a block worth moving to the oldest generation
 _MINIMUM = 1_000_000      # moved objects that never call for a full collection
@@ -32,23 +32,40 @@ _alive = 0                # objects tracked after the last full collection made 
 
 
 @contextmanager
-def gc_paused() -> Iterator[None]:
+def gc_paused(new_model: bool = False) -> Iterator[None]:
     """Pause the cyclic garbage collector (the graph algorithms and model construction
     allocate many small objects, which makes it trigger often for nothing). Usable as a
-    decorator. A block that made many objects moves them to the oldest generation."""
-    global _moved
-    enabled = gc.isenabled()
-    gc.disable()
+    decorator. A block that made many objects moves them to the oldest generation;
+    ``new_model``: the block builds a model (see :func:`collect_if_due`)."""
+    enabled = pause(new_model)
     try:
         yield
     finally:
         if enabled:
-            made = gc.get_count()[0]
-            if made > _LARGE:
-                gc.freeze()
-                gc.unfreeze()
-                _moved += made
-            gc.enable()
+            resume()
+
+
+def pause(new_model: bool = False) -> bool:
+    """Pause the collector; whether it was running (then :func:`resume` it). Before a new
+    model (``new_model``) the models dropped since the last full collection may be due."""
+    if not gc.isenabled():
+        return False
+    if new_model:
+        collect_if_due()
+    gc.disable()
+    return True
+
+
+def resume() -> None:
+    """Restart the collector paused by :func:`pause`, the objects made meanwhile moved to
+    the oldest generation when they are many."""
+    global _moved
+    made = gc.get_count()[0]
+    if made > _LARGE:
+        gc.freeze()
+        gc.unfreeze()
+        _moved += made
+    gc.enable()
 
 
 def collect_if_due() -> None:

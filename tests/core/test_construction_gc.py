@@ -72,9 +72,10 @@ def _collect_all() -> None:
             return
 
 
-def test_models_built_and_dropped_in_a_loop_are_collected():
+@pytest.mark.parametrize("sections", [1500, 3000])
+def test_models_built_and_dropped_in_a_loop_are_collected(sections):
     """A model tree is cyclic (symbols and their owners): the collector must still see the
-    objects of dropped models. Of fifteen 1500-section ladders built and dropped, a few stay
+    objects of dropped models. Of fifteen ladders built and dropped, a few stay
     alive until the next full collection. A large model's objects go straight to the oldest
     generation (sparing the young collections a scan of them), which hides them from the
     count that triggers full collections: without the count kept by
@@ -83,15 +84,15 @@ def test_models_built_and_dropped_in_a_loop_are_collected():
 
     _collect_all()
     for _ in range(15):
-        model = RCLadder(1500)
+        model = RCLadder(sections)
         del model
     alive = sum(1 for o in gc.get_objects() if type(o) is Resistor)
-    assert alive <= 8 * 1500
+    assert alive <= 8 * sections
 
 
 def test_a_large_model_goes_straight_to_the_oldest_generation():
     """The objects of a large model are not left for a young collection to scan."""
     _collect_all()
-    model = RCLadder(1500)
+    model = RCLadder(4000)                       # some 200,000 objects
     assert gc.get_count()[0] < 1000
     assert any(o is model for o in gc.get_objects(generation=2))

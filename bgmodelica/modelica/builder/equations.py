@@ -466,4 +466,4 @@ def _declaration_equations(inst: Element, bindings: list, connector: bool,
         except NotConstant as err:
             raise fail(lex, m.pos, f"{info.comp.name}: {err.what}") from None
         _equation(sym.leaf, value, Ctx(None, lex, {}, False), m, eqs)
-    (owner if connector else inst)._equations.extend(eqs)
+    (owner if connector else inst)._own_equations().extend(eqs)

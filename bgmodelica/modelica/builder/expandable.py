@@ -148,7 +148,7 @@ def _tie(x: Any, y: Any, owner: Bus, lex: Any, node: Any) -> None:
         raise fail(lex, node, f"bus element {y.name if isinstance(y, Bus) else x.name} is an "
                    "expandable connector in one bus and a variable in the other")
     else:
-        owner._equations.append(Equation(y, x))
+        owner._own_equations().append(Equation(y, x))
 
 
 def _connected(a: Bus, b: Bus) -> bool:
