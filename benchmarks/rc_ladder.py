@@ -7,7 +7,7 @@ and solve seconds per n, and the stage split.
 
     python benchmarks/rc_ladder.py [n ...]
     python benchmarks/rc_ladder.py --units [n]     # compile time with and without the unit check
-    python benchmarks/rc_ladder.py --forms [n]     # the three forms against the hand-written floor
+    python benchmarks/rc_ladder.py --forms [n]     # the four forms against the hand-written floor
 """
 
 from __future__ import annotations
@@ -72,19 +72,19 @@ def units_overhead(n: int, reps: int = 3) -> None:
 
 
 def forms(n: int, reps: int = 2) -> None:
-    """The three forms of the ladder (array equations, arrays of components, a component per
-    section) and the hand-written CasADi/CVODES floor, alternating, best of ``reps`` each:
-    construct, compile and 10-s simulation seconds."""
+    """The four forms of the ladder (array equations, arrays of components, a component per
+    section, a ``Section`` component per section) and the hand-written CasADi/CVODES floor,
+    alternating, best of ``reps`` each: construct, compile and 10-s simulation seconds."""
     import gc
 
     from run_all import ladder_by_hand
 
-    from library.examples.circuits import RCLadderArrays, RCLadderVector
+    from library.examples.circuits import RCLadderArrays, RCLadderSections, RCLadderVector
 
     best: dict[str, tuple[float, ...]] = {}
     floor = float("inf")
     for _ in range(reps):
-        for cls in (RCLadderVector, RCLadderArrays, RCLadder):
+        for cls in (RCLadderVector, RCLadderArrays, RCLadder, RCLadderSections):
             gc.collect()
             t0 = time.perf_counter()
             model = cls(n)
@@ -101,9 +101,9 @@ def forms(n: int, reps: int = 2) -> None:
         gc.collect()
         floor = min(floor, ladder_by_hand(n)["total"])
     print(f"n={n}, CasADi/CVODES by hand {floor:.3f} s")
-    print(f"{'form':>15} {'construct':>10} {'compile':>8} {'simulate':>9} {'total':>7}  ratio")
+    print(f"{'form':>16} {'construct':>10} {'compile':>8} {'simulate':>9} {'total':>7}  ratio")
     for name, (a, b, c, d) in best.items():
-        print(f"{name:>15} {a:>10.3f} {b:>8.3f} {c:>9.3f} {d:>7.3f}  {d / floor:.2f}x")
+        print(f"{name:>16} {a:>10.3f} {b:>8.3f} {c:>9.3f} {d:>7.3f}  {d / floor:.2f}x")
 
 
 def main(argv: list[str]) -> None:
