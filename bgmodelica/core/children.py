@@ -15,7 +15,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from .expr import Leaf
-from .variables import Symbol
+from .variables import Symbol, new_symbols
 
 if TYPE_CHECKING:
     from .component import Element
@@ -80,8 +80,7 @@ def instantiate(blueprint: Blueprint, root: Element | None = None,
                 root_name: str | None = None) -> Element:
     """A fresh element as :func:`_describe` saw one: what its constructor would make; with
     ``root``, that element (new, its ``_init_call`` set) is filled instead of making one,
-    named ``root_name``. (Symbols are made as by
-    :func:`~bgmodelica.core.variables.new_symbols`, inlined.)"""
+    named ``root_name``."""
     new = object.__new__
     made: list[tuple[dict[str, Any], dict[str, Any]]] = []
     for cls, call, name, decls, parent in blueprint:
@@ -98,17 +97,7 @@ def instantiate(blueprint: Blueprint, root: Element | None = None,
         attrs["_symbols"] = symbols
         children: dict[str, Element] = {}
         attrs["_children"] = children
-        for key, decl in decls:
-            sym = new(Symbol)
-            sym.name = key
-            sym.decl = decl
-            sym._sx = sym._at = sym.der = sym.der_of = sym.pre = sym.pre_of = None
-            sym.owner = self
-            leaf = new(Leaf)
-            leaf.sym = sym
-            sym.leaf = leaf
-            symbols[key] = sym
-            attrs[key] = leaf
+        new_symbols(self, decls, symbols, attrs)
         if parent < 0:
             root = self
         else:
