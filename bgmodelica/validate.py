@@ -156,11 +156,12 @@ def output_grid(start_time: float, stop_time: float, interval: float | None,
     need = n_points * (max(1, n_columns) + 1) * 8.0 * 2      # values + work arrays
     if n_points > MAX_OUTPUT_POINTS or need > 0.5 * _memory_bytes():
         count = f"{n_points:.0f}" if math.isfinite(n_points) else "infinitely many"
+        fewer = ", record fewer variables (outputs=[...], --outputs)" if n_columns > 1 else ""
         raise OptionError(
             f"the output grid from {start_time:g} to {stop_time:g} s every {interval:g} s has "
             f"{count} points ({n_columns} values each, about {_size(need)}): too many to "
             f"hold (limit {MAX_OUTPUT_POINTS} points, {_size(0.5 * _memory_bytes())}); "
-            "raise the interval (--interval) or shorten the run")
+            f"raise the interval (--interval){fewer} or shorten the run")
     grid = start_time + np.arange(n_full + 1, dtype=float) * interval
     if stop_time - grid[-1] > 1e-9 * interval or len(grid) == 1:
         grid = np.append(grid, stop_time)

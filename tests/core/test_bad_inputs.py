@@ -549,3 +549,17 @@ def test_model_name_too_long_for_a_file_name(capsys, tmp_path):
                     "        yield der(self.x) == -self.x\n")
     code, out, err = run(capsys, ["simulate", f"{path}:{name}"])
     assert_one_line_error(code, out, err, ("file name too long", "-o FILE"))
+
+
+def test_a_grid_of_too_many_values_names_the_ways_out():
+    """Too many values to hold: the refusal says how many, and that fewer variables (or a
+    longer interval) fit; with one column there is nothing to drop."""
+
+    from bgmodelica.errors import OptionError
+    from bgmodelica.validate import output_grid
+
+    with pytest.raises(OptionError, match=r"1001 points \(10000000 values each.*--outputs"):
+        output_grid(0.0, 10.0, 0.01, n_columns=10_000_000)
+    with pytest.raises(OptionError) as err:
+        output_grid(0.0, 1.0, 1e-12)
+    assert "--outputs" not in str(err.value) and "--interval" in str(err.value)
