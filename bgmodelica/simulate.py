@@ -200,7 +200,7 @@ def simulate(model: Component | CompiledModel | str, stop_time: float = 1.0,
     xs, zs, stats, failure = _integrate(dae, solver, grid, init.x0, init.z0, p, opts,
                                         progress)
     n_ok = xs.shape[1]
-    values = ((lambda: np.asarray(_observer(dae, obs_idx)(grid[:n_ok], xs, zs, p)))
+    values = ((lambda: np.asarray(observer(dae, obs_idx)(grid[:n_ok], xs, zs, p)))
               if n_ok else np.zeros((0, len(obs_idx))))
     run = _time.perf_counter() - t_start
     names = list(dae.names) if len(obs_idx) == len(dae.names) else \
@@ -291,7 +291,7 @@ def _finite_run(dae: CasadiDAE, obs_idx: list[int], times: np.ndarray, xs: np.nd
     if not unsafe or not len(times):
         return True
     with np.errstate(all="ignore"):
-        return bool(np.all(np.isfinite(_observer(dae, unsafe)(times, xs, zs, p))))
+        return bool(np.all(np.isfinite(observer(dae, unsafe)(times, xs, zs, p))))
 
 
 def _unsafe(dae: CasadiDAE, idx: Sequence[int]) -> list[int]:
@@ -336,7 +336,7 @@ def _output_indices(dae: CasadiDAE, outputs: Sequence[str] | None,
     return sorted({dae.observed_index[w] for w in wanted})
 
 
-def _observer(dae: CasadiDAE, idx: list[int]) -> Callable:
+def observer(dae: CasadiDAE, idx: list[int]) -> Callable:
     """Evaluate the observed variables ``idx`` on a grid, reading only the states and
     algebraic variables they depend on (built once per model and output set)."""
     key = ("observer", tuple(idx))

@@ -6,8 +6,9 @@ from __future__ import annotations
 
 import math
 
-import casadi as ca
 import numpy as np
+
+from .fast import Fast
 
 
 class CrossingMixin:
@@ -71,11 +72,45 @@ class CrossingMixin:
     def _ind(self, t, x, z) -> np.ndarray:
         return self._ind_fast(t, x, z, self.p)[0].copy()
 
-    def _ind_map(self, m: int) -> ca.Function:
-        key = ("ind_map", m)
-        if key not in self.dae.cache:
-            self.dae.cache[key] = self.fn.indicators.map(m)
-        return self.dae.cache[key]
+    def _first_crossing(self, ts: np.ndarray, X: np.ndarray, Z: np.ndarray,
+                        frozen: np.ndarray) -> tuple[int, np.ndarray | None, np.ndarray] | None:
+        """The first column of a stretch where a state relation left its frozen value: its
+        index, the indicators at the column before (None for the first) and at it; None
+        without one. The columns are read in chunks that double (64, 128, ...): a stretch
+        that ends at an early crossing costs the indicators of its first columns only."""
+        start, chunk, before = 0, 64, None
+        n = len(ts)
+        while start < n:
+            stop = min(n, start + chunk)
+            g = self._ind_columns(ts[start:stop], X[:, start:stop], Z[:, start:stop])
+            hit = np.flatnonzero(self._crossed(g, frozen).any(axis=0))
+            if hit.size:
+                k = int(hit[0])
+                return start + k, (g[:, k - 1] if k else before), g[:, k]
+            before = g[:, -1]
+            start, chunk = stop, 2 * chunk
+        return None
+
+    def _ind_columns(self, ts: np.ndarray, X: np.ndarray, Z: np.ndarray) -> np.ndarray:
+        """The state indicators at the columns of a stretch (times ``ts``, states ``X``,
+        algebraic variables ``Z``), one column each: one buffered call of the indicators
+        mapped over a power of two of columns (made once per size; the last column repeated
+        to fill it), as a call through CasADi's interface costs milliseconds here."""
+        m = len(ts)
+        size = 1 << max(0, (m - 1).bit_length())
+        key = ("ind_columns", size)
+        f = self.dae.cache.get(key)
+        if f is None:
+            f = self.dae.cache[key] = Fast(self.fn.indicators.map(size))
+        fill = size - m
+
+        def padded(a: np.ndarray) -> np.ndarray:
+            return np.concatenate([a, np.repeat(a[:, -1:], fill, axis=1)], axis=1) \
+                if fill and a.shape[0] else a
+
+        cols = lambda a: padded(a).ravel(order="F") if a.shape[0] else 0.0  # noqa: E731
+        g = f(cols(ts.reshape(1, -1)), cols(X), cols(Z), np.tile(self.p, size))[0]
+        return g.reshape(size, -1).T[:, :m].copy()
 
     def _schedule_time_relations(self, t: float, g: np.ndarray, dgdt: np.ndarray) -> None:
         """Next instant where a relation on time alone changes value."""

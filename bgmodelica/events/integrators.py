@@ -15,6 +15,10 @@ import numpy as np
 from ..backends.casadi_dae import CasadiDAE
 from .fast import Fast
 
+#: output points between two events from which the recorded variables are evaluated at
+#: once (below, a call per point costs less than making the mapped function)
+_MAPPED_FROM = 32
+
 
 @contextlib.contextmanager
 def quiet_stderr():
@@ -71,15 +75,16 @@ class SegmentMixin:
 
     def _advance(self, t0: float, t1: float, x, z, outs: np.ndarray):
         """Integrate from t0 to t1 through the output points ``outs`` (inside (t0, t1));
-        stop at the first state event. Returns (t, x, z, cause or None, output rows)."""
+        stop at the first state event. Returns (t, x, z, cause or None, (output times passed,
+        their rows))."""
         fn = self.fn
         if t1 <= t0:
-            return t0, x, z, None, []
+            return t0, x, z, None, (outs[:0], [])
         sel = self.selection
         outs = np.asarray(outs, dtype=float)
         if not fn.state_rel and len(outs) == 0 and sel is None:
             xf, zf = self._integrate_one(t0, t1, x, z)
-            return t1, xf, zf, None, []
+            return t1, xf, zf, None, (outs[:0], [])
         checks = self.opts.checks if fn.state_rel else 1
         if sel is not None:
             checks = max(checks, int(math.ceil((t1 - t0) / sel.spacing - 1e-9)))
@@ -120,17 +125,16 @@ class SegmentMixin:
         last = len(offsets)
         crossing = None
         if fn.state_rel:
-            G = np.asarray(self._ind_map(last)(ts.reshape(1, -1), X, Z, self.p))
             frozen = self.p[fn.rel_slot[fn.state_rel]].astype(bool)
-            cols = np.nonzero(self._crossed(G, frozen).any(axis=0))[0]
-            if cols.size:
-                j = int(cols[0])
+            found = self._first_crossing(ts, X, Z if nz else np.zeros((0, len(ts))), frozen)
+            if found is not None:
+                j, g_before, g_j = found
                 last = j
                 lo = (t0, x, z) if j == 0 else (float(ts[j - 1]), X[:, j - 1],
                                                    Z[:, j - 1] if nz else z)
-                g_lo = self._ind(*lo) if j == 0 else G[:, j - 1]
+                g_lo = self._ind(*lo) if j == 0 else g_before
                 crossing = self._locate(lo[0], lo[1], lo[2], g_lo, float(ts[j]), X[:, j],
-                                        Z[:, j] if nz else z, G[:, j], frozen)
+                                        Z[:, j] if nz else z, g_j, frozen)
         if sel is not None:
             cols = np.searchsorted(offsets, uniform)
             stop_col = self._selection_column(ts, X, Z, z, cols[cols < last])
@@ -138,14 +142,25 @@ class SegmentMixin:
                 crossing = (float(ts[stop_col]), X[:, stop_col],
                             Z[:, stop_col] if nz else z, "select")
                 last = stop_col + 1
-        passed = []
-        for k, c in enumerate(out_cols):
-            if c < last and out_offsets[k] > 0:
-                tk = float(outs[k])
-                passed.append((tk, self._obs(tk, X[:, c], Z[:, c] if nz else z)))
+        keep = (out_cols < last) & inside
+        passed = self._observe(outs[keep], X[:, out_cols[keep]],
+                               Z[:, out_cols[keep]] if nz else None, z)
         if crossing is not None:
             return (*crossing[:3], crossing[3], passed)
         return t1, X[:, -1], Z[:, -1] if nz else z, None, passed
+
+    def _observe(self, times: np.ndarray, X: np.ndarray, Z: np.ndarray | None,
+                 z: np.ndarray) -> tuple[np.ndarray, np.ndarray | list]:
+        """The output times passed and the recorded variables there, one row each: point by
+        point for a few, in one mapped evaluation for many (a long run between events has
+        thousands of output points)."""
+        if len(times) < _MAPPED_FROM:
+            return times, [self._obs(float(tk), X[:, c], Z[:, c] if Z is not None else z)
+                           for c, tk in enumerate(times)]
+        from ..simulate import observer
+
+        zs = Z if Z is not None else np.zeros((0, len(times)))
+        return times, observer(self.dae, self.obs_idx)(times, X, zs, self.p)
 
     def _columns(self, t0: float, x, z, offsets: np.ndarray, opts: dict | None = None):
         """States and algebraic variables at ``t0 + offsets`` (one integrator call with the

@@ -158,10 +158,11 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin, MixedSystemMixin, Segm
             except RuntimeError as err:
                 failure = str(err)
                 break
-            for t_k, row in passed:
-                times.append(t_k)
-                rows.append(row)
-                k_out += 1
+            t_passed, values = passed
+            if len(t_passed):
+                times += t_passed.tolist()
+                rows += values if isinstance(values, list) else [values]    # (a block)
+                k_out += len(t_passed)
             if progress is not None and (t - grid[0]) >= next_report * (stop - grid[0]):
                 progress(min(1.0, (t - grid[0]) / (stop - grid[0])))
                 next_report += 0.05
@@ -191,7 +192,7 @@ class HybridSimulator(CrossingMixin, StateSelectionMixin, MixedSystemMixin, Segm
             x, z, left, right = self._event(t, x, z, "terminal")
             times += [t, t]
             rows += [left, right]
-        return np.array(times), np.array(rows), failure
+        return np.array(times), np.vstack(rows), failure
 
     @property
     def meta(self) -> dict[str, Any]:

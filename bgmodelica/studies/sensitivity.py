@@ -212,7 +212,7 @@ def forward_run(compiled: Any, dae: Any, p: np.ndarray, grid: np.ndarray, wrt: l
     initial time. Smooth models only (see :func:`refuse_events`)."""
     from ..backends.casadi_init import initialize
     from ..diagnose import check_initial_point
-    from ..simulate import _observer, _xdot
+    from ..simulate import _xdot, observer
 
     refuse_events(dae)
     p = np.asarray(p, dtype=float)
@@ -254,7 +254,7 @@ def forward_run(compiled: Any, dae: Any, p: np.ndarray, grid: np.ndarray, wrt: l
                          jx.reshape(N - 1, nxi, ns)], axis=0)[:, :nx]          # (N, nx, ns)
     SZ = np.concatenate([sz0[None], jz.reshape(N - 1, nz, ns)], axis=0) if nz \
         else np.zeros((N, 0, ns))
-    Y = np.asarray(_observer(dae, obs_idx)(grid, X, Z, p))
+    Y = np.asarray(observer(dae, obs_idx)(grid, X, Z, p))
     g = _observed_sens(dae, obs_idx, ns)
     seeds_t = np.concatenate([SX, SZ, np.broadcast_to(E, (N, n_p, ns))], axis=1)  # (N,nin,ns)
     nin = seeds_t.shape[1]
