@@ -61,6 +61,19 @@ def test_bouncing_ball_impacts_and_rest():
     assert np.max(np.abs(res["h"] - ball_height(res.time, pieces))) < 1e-7
 
 
+def test_bouncing_ball_on_a_fine_output_grid():
+    """Thousands of output points between impacts: the first crossing is found in a late
+    chunk of the stretch's indicators (the first impact near column 4,500), and the rows of
+    a long stretch are evaluated at once; both agree with the flight pieces."""
+    res = bg.simulate(BouncingBall(), stop_time=1.5, interval=1e-4, **TIGHT)
+    impacts, pieces = ball_reference()
+    events = np.array(res.meta["event_times"])
+    expected = [t for t in impacts if t <= 1.5]
+    assert len(events) == len(expected) and np.max(np.abs(events - expected)) < 1e-8
+    assert len(res.time) == 15001 + 2 * len(expected)      # each event adds two rows
+    assert np.max(np.abs(res["h"] - ball_height(res.time, pieces))) < 1e-7
+
+
 def test_bouncing_ball_parameters_by_name():
     res = bg.simulate(BouncingBall(), stop_time=2.0, interval=0.01,
                       params={"h0": 2.0, "v0": 1.0, "e": 0.5}, **TIGHT)
